@@ -1,0 +1,79 @@
+#include "control/exact_model_000.hpp"
+
+#include <Eigen/Core>
+#include <unsupported/Eigen/MatrixFunctions>
+
+namespace imd::control {
+
+Eigen::Matrix3d seed000_axis_generator(const MotorParameters& motor) {
+  const Seed000Constants k = derive_seed000(motor);
+  Eigen::Matrix3d a;
+  a << -k.alpha_per_s, k.alpha_per_s * motor.Lm_H, 0.0,              //
+      k.alpha_per_s * k.beta_per_H, -k.gamma_per_s, 1.0 / k.sigma_H,  //
+      0.0, 0.0, 0.0;
+  return a;
+}
+
+Eigen::Matrix3d additive_compound(const Eigen::Matrix3d& a) {
+  Eigen::Matrix3d m;
+  m << a(0, 0) + a(1, 1), a(1, 2), -a(0, 2),  //
+      a(2, 1), a(0, 0) + a(2, 2), a(0, 1),    //
+      -a(2, 0), a(1, 0), a(1, 1) + a(2, 2);
+  return m;
+}
+
+ExactModel000Coefficients discretize_seed000(const MotorParameters& motor, double delta_s) {
+  const Seed000Constants k = derive_seed000(motor);
+  const double friction_per_s = motor.friction_Nms / motor.J_kgm2;
+
+  ExactModel000Coefficients c;
+  c.delta_s = delta_s;
+
+  // Electrical part: A_d and B_d are blocks of exp(A3 delta).
+  const Eigen::Matrix3d a3 = seed000_axis_generator(motor);
+  const Eigen::Matrix3d e3 = (a3 * delta_s).exp();
+  c.a11 = e3(0, 0);
+  c.a12 = e3(0, 1);
+  c.a21 = e3(1, 0);
+  c.a22 = e3(1, 1);
+  c.b1 = e3(0, 2);
+  c.b2 = e3(1, 2);
+
+  // The skew product q(t) = I~^T J Phi~ is a combination of the 2x2 minors of rows (phi, i) of
+  // exp(A3 t), i.e. of the first row of exp(M t) with M the additive compound. Speed and
+  // position need its integrals weighted by the friction decay; both come out of one block
+  // exponential (Van Loan):
+  //   exp([M I 0; 0 -f I I; 0 0 0] delta) = [. Y Z; . . .; . . .],
+  //   Y = int_0^delta exp(M u) exp(-f (delta - u)) du,
+  //   Z = int_0^delta exp(M u) (1 - exp(-f (delta - u))) / f du  (-> (delta - u) as f -> 0).
+  const Eigen::Matrix3d m = additive_compound(a3);
+  Eigen::Matrix<double, 9, 9> big = Eigen::Matrix<double, 9, 9>::Zero();
+  big.block<3, 3>(0, 0) = m;
+  big.block<3, 3>(0, 3).setIdentity();
+  big.block<3, 3>(3, 3) = -friction_per_s * Eigen::Matrix3d::Identity();
+  big.block<3, 3>(3, 6).setIdentity();
+  const Eigen::Matrix<double, 9, 9> e9 = (big * delta_s).exp();
+  const Eigen::Matrix3d y = e9.block<3, 3>(0, 3);
+  const Eigen::Matrix3d z = e9.block<3, 3>(0, 6);
+  // q = m00 I^T J Phi - m01 Phi^T J v - m02 I^T J v, with m the first row of exp(M t).
+  c.eta1 = k.mu_per_kgm2 * y(0, 0);
+  c.eta2 = -k.mu_per_kgm2 * y(0, 1);
+  c.eta3 = -k.mu_per_kgm2 * y(0, 2);
+  c.kappa1 = k.mu_per_kgm2 * z(0, 0);
+  c.kappa2 = -k.mu_per_kgm2 * z(0, 1);
+  c.kappa3 = -k.mu_per_kgm2 * z(0, 2);
+
+  // Mechanical part: states (th, w, C_L) with dth = w, dw = -f w - C_L/J, dC_L = 0.
+  Eigen::Matrix3d mech = Eigen::Matrix3d::Zero();
+  mech(0, 1) = 1.0;
+  mech(1, 1) = -friction_per_s;
+  mech(1, 2) = -1.0 / motor.J_kgm2;
+  const Eigen::Matrix3d e_mech = (mech * delta_s).exp();
+  c.omega_decay = e_mech(1, 1);
+  c.omega_to_theta_s = e_mech(0, 1);
+  c.load_to_omega = e_mech(1, 2);
+  c.load_to_theta = e_mech(0, 2);
+  return c;
+}
+
+}  // namespace imd::control

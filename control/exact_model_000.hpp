@@ -1,0 +1,94 @@
+#pragma once
+/// Exact sampled model of the voltage-fed induction motor under the preliminary feedback (2)
+/// of paper 000, Section II. In the rotor-aligned frame the electrical states obey a linear
+/// time-invariant system, so with the input held over the period the model is exact:
+///
+///   [Phi; I]_{k+1} = A_d [Phi; I]_k + B_d v_k
+///   w_{k+1} = w_k + eta1 I_k^T J Phi_k + (eta2 Phi_k^T + eta3 I_k^T) J v_k - C_L delta / J
+///   th_{k+1} = th_k + w_k delta + kappa1 I_k^T J Phi_k + (kappa2 Phi_k^T + kappa3 I_k^T) J v_k
+///              - C_L delta^2 / (2 J)
+///
+/// generalised to viscous friction c (w_k and C_L then enter through exponential weights; with
+/// c = 0 the paper's equations result). The derivation is in docs/derivations.md.
+#include "control/frames.hpp"
+#include "control/motor_parameters.hpp"
+
+namespace imd::control {
+
+/// The constant coefficients of the exact sampled model for one motor and sample period.
+struct ExactModel000Coefficients {
+  double delta_s = 0.0;  ///< sample period
+  // A_d = [a11 I, a12 I; a21 I, a22 I] and B_d = [b1 I; b2 I].
+  double a11 = 0.0, a12 = 0.0, a21 = 0.0, a22 = 0.0;
+  double b1 = 0.0, b2 = 0.0;
+  // Speed and position increments per unit of the skew products (units rad/s or rad per A Wb,
+  // per Wb V and per A V).
+  double eta1 = 0.0, eta2 = 0.0, eta3 = 0.0;
+  double kappa1 = 0.0, kappa2 = 0.0, kappa3 = 0.0;
+  // Mechanical coefficients: exp(-c delta/J) and its integrals; 1, delta, -delta/J and
+  // -delta^2/(2J) without friction.
+  double omega_decay = 1.0;      ///< coefficient of w_k in w_{k+1}
+  double omega_to_theta_s = 0.0;  ///< coefficient of w_k in th_{k+1}
+  double load_to_omega = 0.0;     ///< coefficient of C_L in w_{k+1}, rad/s per N m
+  double load_to_theta = 0.0;     ///< coefficient of C_L in th_{k+1}, rad per N m
+};
+
+/// Computes the coefficients numerically exactly from matrix exponentials (Eigen's
+/// MatrixFunctions). Not for tick context: call once at start-up. Requires valid parameters
+/// and delta_s > 0.
+ExactModel000Coefficients discretize_seed000(const MotorParameters& motor, double delta_s);
+
+/// Generator of one axis of the rotor-frame dynamics (5) with the held input as a third state:
+/// d/dt (phi, i, v) = A3 (phi, i, v); A = A3 (x) I2 acts on both axes alike.
+Eigen::Matrix3d seed000_axis_generator(const MotorParameters& motor);
+
+/// Additive second compound A^[2] of a 3x3 matrix, index pairs ordered (0,1), (0,2), (1,2).
+/// The 2x2 minors of exp(A t) are the entries of exp(A^[2] t).
+Eigen::Matrix3d additive_compound(const Eigen::Matrix3d& a);
+
+/// State in the rotor-aligned frame: (Phi~, I~, w, th) of paper 000.
+template <typename T>
+struct RotorFrameState {
+  Vec2<T> flux_r_AB_Wb = Vec2<T>::Zero();  ///< rotor flux
+  Vec2<T> i_s_AB_A = Vec2<T>::Zero();      ///< stator current
+  T omega_mech_rad_s = T(0);               ///< mechanical rotor speed
+  T theta_mech_rad = T(0);                 ///< mechanical rotor position
+};
+
+/// One-step predictor of the exact sampled model, in float or double.
+template <typename T>
+class ExactModel000 {
+ public:
+  explicit ExactModel000(const ExactModel000Coefficients& c) noexcept
+      : a11_(T(c.a11)), a12_(T(c.a12)), a21_(T(c.a21)), a22_(T(c.a22)), b1_(T(c.b1)),
+        b2_(T(c.b2)), eta1_(T(c.eta1)), eta2_(T(c.eta2)), eta3_(T(c.eta3)),
+        kappa1_(T(c.kappa1)), kappa2_(T(c.kappa2)), kappa3_(T(c.kappa3)),
+        omega_decay_(T(c.omega_decay)), omega_to_theta_s_(T(c.omega_to_theta_s)),
+        load_to_omega_(T(c.load_to_omega)), load_to_theta_(T(c.load_to_theta)) {}
+
+  /// State at step k+1 from the state at step k, the rotor-frame input v~_k (the voltage v of
+  /// (2) rotated by -p th_k) and the load C_L,k held over the period. Tick context.
+  RotorFrameState<T> predict(const RotorFrameState<T>& x, const Vec2<T>& v_AB_V,
+                             T load_Nm) const noexcept {
+    const T torque_product = dot_J(x.i_s_AB_A, x.flux_r_AB_Wb);  // I^T J Phi
+    const T flux_input_product = dot_J(x.flux_r_AB_Wb, v_AB_V);  // Phi^T J v
+    const T current_input_product = dot_J(x.i_s_AB_A, v_AB_V);   // I^T J v
+    RotorFrameState<T> next;
+    next.flux_r_AB_Wb = a11_ * x.flux_r_AB_Wb + a12_ * x.i_s_AB_A + b1_ * v_AB_V;
+    next.i_s_AB_A = a21_ * x.flux_r_AB_Wb + a22_ * x.i_s_AB_A + b2_ * v_AB_V;
+    next.omega_mech_rad_s = omega_decay_ * x.omega_mech_rad_s + eta1_ * torque_product +
+                            eta2_ * flux_input_product + eta3_ * current_input_product +
+                            load_to_omega_ * load_Nm;
+    next.theta_mech_rad = x.theta_mech_rad + omega_to_theta_s_ * x.omega_mech_rad_s +
+                          kappa1_ * torque_product + kappa2_ * flux_input_product +
+                          kappa3_ * current_input_product + load_to_theta_ * load_Nm;
+    return next;
+  }
+
+ private:
+  T a11_, a12_, a21_, a22_, b1_, b2_;
+  T eta1_, eta2_, eta3_, kappa1_, kappa2_, kappa3_;
+  T omega_decay_, omega_to_theta_s_, load_to_omega_, load_to_theta_;
+};
+
+}  // namespace imd::control

@@ -1,0 +1,47 @@
+#pragma once
+/// Two-axis vectors and the rotations between the stationary (alpha-beta) frame and the frame
+/// aligned with the electrical rotor position (called AB, as in paper 001; paper 000 marks the
+/// same quantities with a tilde). Tick context: all functions are noexcept and allocation-free.
+#include <Eigen/Core>
+#include <cmath>
+
+namespace imd::control {
+
+template <typename T>
+using Vec2 = Eigen::Matrix<T, 2, 1>;
+
+/// a^T J b with J = [[0, -1], [1, 0]], the skew product the papers write I^T J Phi.
+template <typename T>
+constexpr T dot_J(const Vec2<T>& a, const Vec2<T>& b) noexcept {
+  return a.y() * b.x() - a.x() * b.y();
+}
+
+/// J x: the vector turned by +90 degrees.
+template <typename T>
+Vec2<T> J_times(const Vec2<T>& x) noexcept {
+  return Vec2<T>(-x.y(), x.x());
+}
+
+/// The rotation e^{angle J}, stored as cosine and sine so that one evaluation of the
+/// trigonometric functions serves both directions.
+template <typename T>
+struct Rotation {
+  T cos_angle = T(1);
+  T sin_angle = T(0);
+
+  static Rotation from_angle(T angle_rad) noexcept {
+    using std::cos;
+    using std::sin;
+    return {cos(angle_rad), sin(angle_rad)};
+  }
+  /// e^{angle J} x: from the rotor-aligned frame to the stationary frame.
+  Vec2<T> apply(const Vec2<T>& x) const noexcept {
+    return Vec2<T>(cos_angle * x.x() - sin_angle * x.y(), sin_angle * x.x() + cos_angle * x.y());
+  }
+  /// e^{-angle J} x: from the stationary frame to the rotor-aligned frame.
+  Vec2<T> apply_inverse(const Vec2<T>& x) const noexcept {
+    return Vec2<T>(cos_angle * x.x() + sin_angle * x.y(), -sin_angle * x.x() + cos_angle * x.y());
+  }
+};
+
+}  // namespace imd::control

@@ -1,0 +1,116 @@
+#include "hal_sim/induction_motor_plant.hpp"
+
+#include <cassert>
+
+#include "hal_sim/rk4.hpp"
+
+namespace imd::sim {
+namespace {
+
+using StateVector = InductionMotorPlant::StateVector;
+
+StateVector pack(const PlantState& s) {
+  StateVector x;
+  x << s.flux_r_alphabeta_Wb, s.i_s_alphabeta_A, s.omega_mech_rad_s, s.theta_mech_rad;
+  return x;
+}
+
+PlantState unpack(const StateVector& x) {
+  return {x.segment<2>(0), x.segment<2>(2), x(4), x(5)};
+}
+
+}  // namespace
+
+InductionMotorPlant::InductionMotorPlant(const control::MotorParameters& motor,
+                                         const PlantConfig& config)
+    : motor_(motor), k_(control::derive_seed000(motor)), config_(config) {
+  assert(config.period_s > 0.0 && config.rk4_substeps >= 1);
+}
+
+double InductionMotorPlant::torque_Nm(const PlantState& s) const noexcept {
+  return torque_Nm(s.i_s_alphabeta_A, s.flux_r_alphabeta_Wb);
+}
+
+double InductionMotorPlant::torque_Nm(const Vec2& i_s_A, const Vec2& flux_r_Wb) const noexcept {
+  return k_.mu_per_kgm2 * motor_.J_kgm2 * control::dot_J(i_s_A, flux_r_Wb);
+}
+
+Vec2 InductionMotorPlant::flux_s_alphabeta_Wb() const noexcept {
+  return k_.sigma_H * state_.i_s_alphabeta_A + motor_.Lm_H / motor_.Lr_H * state_.flux_r_alphabeta_Wb;
+}
+
+StateVector InductionMotorPlant::voltage_fed_derivative(const StateVector& x, const Vec2& u,
+                                                        double load_Nm) const noexcept {
+  const Vec2 flux = x.segment<2>(0);
+  const Vec2 current = x.segment<2>(2);
+  const double omega = x(4);
+  const double p_omega = motor_.pole_pairs * omega;
+  const Vec2 j_flux = control::J_times(flux);
+  const double torque = torque_Nm(current, flux);
+  StateVector dx;
+  dx.segment<2>(0) = -k_.alpha_per_s * flux + p_omega * j_flux + k_.alpha_per_s * motor_.Lm_H * current;
+  dx.segment<2>(2) = k_.alpha_per_s * k_.beta_per_H * flux - p_omega * k_.beta_per_H * j_flux -
+                     k_.gamma_per_s * current + u / k_.sigma_H;
+  dx(4) = (torque - motor_.friction_Nms * omega - load_Nm) / motor_.J_kgm2;
+  dx(5) = omega;
+  return dx;
+}
+
+template <typename VoltageLaw>
+void InductionMotorPlant::integrate_voltage_fed(const VoltageLaw& voltage_of_state,
+                                                double load_Nm) noexcept {
+  const double h = config_.period_s / config_.rk4_substeps;
+  const auto rhs = [&](const StateVector& x) {
+    return voltage_fed_derivative(x, voltage_of_state(x), load_Nm);
+  };
+  StateVector x = pack(state_);
+  for (int i = 0; i < config_.rk4_substeps; ++i) x = rk4_step(x, h, rhs);
+  state_ = unpack(x);
+  time_s_ += config_.period_s;
+}
+
+void InductionMotorPlant::step_voltage(const Vec2& u_s_alphabeta_V, double load_Nm) noexcept {
+  integrate_voltage_fed([&](const StateVector&) { return u_s_alphabeta_V; }, load_Nm);
+}
+
+void InductionMotorPlant::step_analog_feedback(const Vec2& v_AB_V, double load_Nm) noexcept {
+  const double p = motor_.pole_pairs;
+  integrate_voltage_fed(
+      [&](const StateVector& x) -> Vec2 {
+        const Vec2 flux = x.segment<2>(0);
+        const Vec2 current = x.segment<2>(2);
+        const Vec2 compensation =
+            k_.sigma_H * p * x(4) * control::J_times<double>(current + k_.beta_per_H * flux);
+        return compensation + control::Rotation<double>::from_angle(p * x(5)).apply(v_AB_V);
+      },
+      load_Nm);
+}
+
+void InductionMotorPlant::step_current_fed(const Vec2& i_s_AB_A, double load_Nm) noexcept {
+  // The current is algebraic, I = e^{p th J} i_AB; only Phi, w and th are integrated. The
+  // current slots of the state vector carry I and have zero derivative in the integrator.
+  const double p = motor_.pole_pairs;
+  const auto current_at = [&](double theta_mech_rad) {
+    return control::Rotation<double>::from_angle(p * theta_mech_rad).apply(i_s_AB_A);
+  };
+  const auto rhs = [&](const StateVector& x) {
+    const Vec2 flux = x.segment<2>(0);
+    const Vec2 current = current_at(x(5));
+    const double torque = torque_Nm(current, flux);
+    StateVector dx;
+    dx.segment<2>(0) = -k_.alpha_per_s * flux + p * x(4) * control::J_times(flux) +
+                       k_.alpha_per_s * motor_.Lm_H * current;
+    dx.segment<2>(2).setZero();
+    dx(4) = (torque - motor_.friction_Nms * x(4) - load_Nm) / motor_.J_kgm2;
+    dx(5) = x(4);
+    return dx;
+  };
+  const double h = config_.period_s / config_.rk4_substeps;
+  StateVector x = pack(state_);
+  for (int i = 0; i < config_.rk4_substeps; ++i) x = rk4_step(x, h, rhs);
+  x.segment<2>(2) = current_at(x(5));
+  state_ = unpack(x);
+  time_s_ += config_.period_s;
+}
+
+}  // namespace imd::sim

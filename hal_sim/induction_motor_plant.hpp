@@ -1,0 +1,83 @@
+#pragma once
+/// Continuous model (1) of paper 000 in the stationary (alpha-beta) frame, integrated with RK4:
+///
+///   dPhi/dt = -alpha Phi + p w J Phi + alpha Lm I
+///   dI/dt   = alpha beta Phi - p beta w J Phi - gamma I + u / sigma
+///   dw/dt   = (T_e - c w - T_L) / J,   T_e = 3/2 p (Lm/Lr) I^T J Phi
+///   dth/dt  = w
+///
+/// The stator can be voltage-fed (u held over the period, as an inverter applies it), voltage-
+/// fed through the ideal analog inner feedback (2) evaluated continuously inside the
+/// integration, or current-fed (I~ held in the rotor-aligned frame, as paper 001 assumes).
+#include <Eigen/Core>
+
+#include "control/frames.hpp"
+#include "control/motor_parameters.hpp"
+
+namespace imd::sim {
+
+using Vec2 = control::Vec2<double>;
+
+/// Plant state in the stationary frame.
+struct PlantState {
+  Vec2 flux_r_alphabeta_Wb = Vec2::Zero();  ///< rotor flux Phi
+  Vec2 i_s_alphabeta_A = Vec2::Zero();      ///< stator current I
+  double omega_mech_rad_s = 0.0;            ///< mechanical speed w
+  double theta_mech_rad = 0.0;              ///< mechanical position th
+};
+
+struct PlantConfig {
+  double period_s = 1e-4;  ///< one call of a step function advances this much
+  int rk4_substeps = 10;   ///< RK4 steps per period
+};
+
+class InductionMotorPlant {
+ public:
+  /// Packed state for the integrator: (Phi_a, Phi_b, I_a, I_b, w, th).
+  using StateVector = Eigen::Matrix<double, 6, 1>;
+
+  /// Requires valid motor parameters, period_s > 0 and rk4_substeps >= 1.
+  InductionMotorPlant(const control::MotorParameters& motor, const PlantConfig& config);
+
+  const PlantState& state() const noexcept { return state_; }
+  void set_state(const PlantState& state) noexcept { state_ = state; }
+  double time_s() const noexcept { return time_s_; }
+  const PlantConfig& config() const noexcept { return config_; }
+
+  /// One period with the stator voltage u held (stationary frame).
+  void step_voltage(const Vec2& u_s_alphabeta_V, double load_Nm) noexcept;
+
+  /// One period under the ideal analog inner feedback (2) of paper 000:
+  /// u(t) = sigma p w J (I + beta Phi) + e^{p th(t) J} v~_k, evaluated at every RK4 stage.
+  /// v~_k = e^{-p th_k J} v_k is the held rotor-frame input.
+  void step_analog_feedback(const Vec2& v_AB_V, double load_Nm) noexcept;
+
+  /// One period current-fed: I(t) = e^{p th(t) J} i_AB with i_AB held (paper 001's zero-order
+  /// hold in the rotor frame). On return the stator current is that of the end of the period.
+  void step_current_fed(const Vec2& i_s_AB_A, double load_Nm) noexcept;
+
+  /// Electromagnetic torque 3/2 p (Lm/Lr) I^T J Phi of the present state.
+  double torque_Nm() const noexcept { return torque_Nm(state_); }
+  double torque_Nm(const PlantState& state) const noexcept;
+  /// 3/2 p (Lm/Lr) I^T J Phi for a current and rotor flux in the same frame.
+  double torque_Nm(const Vec2& i_s_A, const Vec2& flux_r_Wb) const noexcept;
+
+  /// Stator flux sigma I + (Lm/Lr) Phi of the present state (stationary frame).
+  Vec2 flux_s_alphabeta_Wb() const noexcept;
+
+  /// dx/dt of model (1) for stator voltage u and load torque. Exposed for benchmarks.
+  StateVector voltage_fed_derivative(const StateVector& x, const Vec2& u_s_alphabeta_V,
+                                     double load_Nm) const noexcept;
+
+ private:
+  template <typename VoltageLaw>
+  void integrate_voltage_fed(const VoltageLaw& voltage_of_state, double load_Nm) noexcept;
+
+  control::MotorParameters motor_;
+  control::Seed000Constants k_;
+  PlantConfig config_;
+  PlantState state_;
+  double time_s_ = 0.0;
+};
+
+}  // namespace imd::sim

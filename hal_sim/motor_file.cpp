@@ -1,0 +1,99 @@
+#include "hal_sim/motor_file.hpp"
+
+#include <fmt/format.h>
+
+#include <cmath>
+#include <fstream>
+
+#include "hal_sim/config_error.hpp"
+
+namespace imd::sim {
+namespace {
+
+const char* type_name(const toml::node& node) {
+  switch (node.type()) {
+    case toml::node_type::string: return "a string";
+    case toml::node_type::integer: return "an integer";
+    case toml::node_type::floating_point: return "a number";
+    case toml::node_type::boolean: return "a boolean";
+    case toml::node_type::table: return "a table";
+    case toml::node_type::array: return "an array";
+    default: return "a date or time";
+  }
+}
+
+const toml::node& require_key(const toml::table& motor, std::string_view key,
+                              std::string_view source) {
+  const toml::node* node = motor.get(key);
+  if (node == nullptr) {
+    throw ConfigError(fmt::format("{}: missing key motor.{}", source, key));
+  }
+  return *node;
+}
+
+double require_number(const toml::table& motor, std::string_view key, std::string_view source) {
+  const toml::node& node = require_key(motor, key, source);
+  if (const auto* real = node.as_floating_point()) return real->get();
+  if (const auto* integer = node.as_integer()) return static_cast<double>(integer->get());
+  throw ConfigError(
+      fmt::format("{}: motor.{} must be a number, got {}", source, key, type_name(node)));
+}
+
+int require_integer(const toml::table& motor, std::string_view key, std::string_view source) {
+  const toml::node& node = require_key(motor, key, source);
+  if (const auto* integer = node.as_integer()) {
+    const int64_t value = integer->get();
+    if (value < 1 || value > 64) {
+      throw ConfigError(
+          fmt::format("{}: motor.{} = {}: must be an integer in 1..64", source, key, value));
+    }
+    return static_cast<int>(value);
+  }
+  throw ConfigError(
+      fmt::format("{}: motor.{} must be an integer, got {}", source, key, type_name(node)));
+}
+
+}  // namespace
+
+toml::table parse_toml_file(const std::filesystem::path& path) {
+  if (!std::ifstream(path).good()) {
+    throw ConfigError(fmt::format("{}: cannot open file", path.string()));
+  }
+  try {
+    return toml::parse_file(path.string());
+  } catch (const toml::parse_error& error) {
+    throw ConfigError(fmt::format("{}:{}:{}: TOML syntax error: {}", path.string(),
+                                  error.source().begin.line, error.source().begin.column,
+                                  error.description()));
+  }
+}
+
+control::MotorParameters parse_motor_table(const toml::table& document, std::string_view source) {
+  const toml::node* motor_node = document.get("motor");
+  if (motor_node == nullptr) throw ConfigError(fmt::format("{}: missing table [motor]", source));
+  const toml::table* motor = motor_node->as_table();
+  if (motor == nullptr) {
+    throw ConfigError(
+        fmt::format("{}: motor must be a table, got {}", source, type_name(*motor_node)));
+  }
+  control::MotorParameters p;
+  p.Rs_Ohm = require_number(*motor, "Rs_Ohm", source);
+  p.Ls_H = require_number(*motor, "Ls_H", source);
+  p.Lm_H = require_number(*motor, "Lm_H", source);
+  p.Rr_Ohm = require_number(*motor, "Rr_Ohm", source);
+  p.Lr_H = require_number(*motor, "Lr_H", source);
+  p.J_kgm2 = require_number(*motor, "J_kgm2", source);
+  p.pole_pairs = require_integer(*motor, "pole_pairs", source);
+  p.friction_Nms = require_number(*motor, "friction_Nms", source);
+  if (const auto problem = control::find_invalid_parameter(p)) {
+    throw ConfigError(fmt::format("{}: motor.{} = {}: {}", source, problem->key, problem->value,
+                                  problem->rule));
+  }
+  return p;
+}
+
+control::MotorParameters load_motor_file(const std::filesystem::path& path) {
+  return parse_motor_table(parse_toml_file(path), path.string());
+}
+
+}  // namespace imd::sim

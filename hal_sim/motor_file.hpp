@@ -1,0 +1,28 @@
+#pragma once
+/// Loading of the [motor] table from TOML (a motor file or a scenario file), with validation.
+///
+///   [motor]
+///   Rs_Ohm = 14.0        Ls_H = 0.4       Lm_H = 0.377     Rr_Ohm = 10.1
+///   Lr_H = 0.4128        J_kgm2 = 0.01    pole_pairs = 1   friction_Nms = 0.0
+///
+/// All eight keys are required; other keys in the table are free (names, ratings). Host only.
+#include <filesystem>
+#include <string_view>
+#include <toml++/toml.h>
+
+#include "control/motor_parameters.hpp"
+
+namespace imd::sim {
+
+/// Reads and validates the [motor] table of a TOML file. Throws ConfigError naming the file,
+/// the key and the value on a syntax error, a missing key, a wrong type or an invalid value.
+control::MotorParameters load_motor_file(const std::filesystem::path& path);
+
+/// Reads and validates the [motor] table of an already parsed document. `source` names the
+/// document in error messages.
+control::MotorParameters parse_motor_table(const toml::table& document, std::string_view source);
+
+/// Parses a TOML file, turning a syntax error into a ConfigError with file, line and column.
+toml::table parse_toml_file(const std::filesystem::path& path);
+
+}  // namespace imd::sim

@@ -1,0 +1,190 @@
+// Exact sampled model of paper 000 against the continuous plant with the ideal analog feedback
+// (2), and the derived quantities of Sections II and IV.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <random>
+#include <unsupported/Eigen/MatrixFunctions>
+
+#include "control/exact_model_000.hpp"
+#include "control/exact_model_001.hpp"
+#include "hal_sim/induction_motor_plant.hpp"
+#include "test_motors.hpp"
+
+namespace imd::control {
+namespace {
+
+constexpr double kDelta_s = 1e-4;  // the paper's sample period
+
+// A matrix exponential by scaling and squaring with a degree-13 Pade approximant has a
+// relative error of a few ulp times the number of squarings; here |A delta| < 1, so a handful
+// of squarings at most. 1e-12 leaves two orders of magnitude of margin.
+constexpr double kExpmTolerance = 1e-12;
+
+// The exact model must match a very fine integration of the continuous model to 1e-9. With
+// 1000 RK4 substeps per period (h = 1e-7 s) the truncation error per step is of order
+// (|lambda| h)^5 / 120 with |lambda| < 1e4 (stator dynamics plus p w), i.e. < 1e-17, and the
+// rounding error accumulated over 1000 steps is of order 1e-13: the check measures the model.
+constexpr int kFineSubsteps = 1000;
+constexpr double kExactnessTolerance = 1e-9;
+
+double relative_error(const Vec2<double>& value, const Vec2<double>& reference) {
+  return (value - reference).norm() / reference.norm();
+}
+double relative_error(double value, double reference) {
+  return std::abs(value - reference) / std::abs(reference);
+}
+
+struct Draw {
+  RotorFrameState<double> x;
+  Vec2<double> v_AB_V;
+  double load_Nm;
+};
+
+/// A random state and input at the motor's typical magnitudes. Magnitudes are kept away from
+/// zero (at least 20 % of typical) so that relative errors are meaningful.
+Draw random_draw(std::mt19937_64& rng, const test::TestMotor& m) {
+  std::uniform_real_distribution<double> unit(0.2, 1.0);
+  std::uniform_real_distribution<double> angle(-std::numbers::pi, std::numbers::pi);
+  std::bernoulli_distribution negative(0.5);
+  const auto vector = [&](double magnitude) {
+    const double a = angle(rng);
+    const double r = magnitude * unit(rng);
+    return Vec2<double>(r * std::cos(a), r * std::sin(a));
+  };
+  Draw d;
+  d.x.flux_r_AB_Wb = vector(m.flux_Wb);
+  d.x.i_s_AB_A = vector(m.current_A);
+  d.x.omega_mech_rad_s = (negative(rng) ? -1.0 : 1.0) * m.speed_rad_s * unit(rng);
+  d.x.theta_mech_rad = std::uniform_real_distribution<double>(0.5, 6.0)(rng);
+  d.v_AB_V = vector(m.voltage_V);
+  d.load_Nm = (negative(rng) ? -1.0 : 1.0) * m.load_Nm * unit(rng);
+  return d;
+}
+
+TEST(ExactModel000, OneStepMatchesFineIntegrationOfThePlant) {
+  for (const auto& motor : test::test_motors()) {
+    SCOPED_TRACE(motor.name);
+    const int p = motor.parameters.pole_pairs;
+    const ExactModel000<double> model(discretize_seed000(motor.parameters, kDelta_s));
+    sim::InductionMotorPlant plant(motor.parameters, {kDelta_s, kFineSubsteps});
+    std::mt19937_64 rng(2024);
+    double worst_flux = 0, worst_current = 0, worst_speed = 0, worst_position = 0;
+    for (int trial = 0; trial < 200; ++trial) {
+      const Draw d = random_draw(rng, motor);
+      const auto to_stator = Rotation<double>::from_angle(p * d.x.theta_mech_rad);
+      plant.set_state({to_stator.apply(d.x.flux_r_AB_Wb), to_stator.apply(d.x.i_s_AB_A),
+                       d.x.omega_mech_rad_s, d.x.theta_mech_rad});
+      plant.step_analog_feedback(d.v_AB_V, d.load_Nm);
+      const sim::PlantState& s = plant.state();
+      const auto to_rotor = Rotation<double>::from_angle(p * s.theta_mech_rad);
+
+      const RotorFrameState<double> predicted = model.predict(d.x, d.v_AB_V, d.load_Nm);
+      worst_flux = std::max(worst_flux, relative_error(predicted.flux_r_AB_Wb,
+                                                       to_rotor.apply_inverse(s.flux_r_alphabeta_Wb)));
+      worst_current = std::max(worst_current, relative_error(predicted.i_s_AB_A,
+                                                             to_rotor.apply_inverse(s.i_s_alphabeta_A)));
+      worst_speed = std::max(worst_speed, relative_error(predicted.omega_mech_rad_s, s.omega_mech_rad_s));
+      worst_position = std::max(worst_position, relative_error(predicted.theta_mech_rad, s.theta_mech_rad));
+    }
+    RecordProperty(motor.name + "_worst_flux", std::to_string(worst_flux));
+    std::printf("%-18s worst relative error: flux %.2e current %.2e speed %.2e position %.2e\n",
+                motor.name.c_str(), worst_flux, worst_current, worst_speed, worst_position);
+    EXPECT_LE(worst_flux, kExactnessTolerance);
+    EXPECT_LE(worst_current, kExactnessTolerance);
+    EXPECT_LE(worst_speed, kExactnessTolerance);
+    EXPECT_LE(worst_position, kExactnessTolerance);
+  }
+}
+
+TEST(ExactModel000, FluxObserverPoleIsInsideTheUnitCircle) {
+  // Section IV: the flux observer error obeys e_{k+1} = a11 e_k and needs |a11| < 1.
+  for (const auto& motor : test::test_motors()) {
+    for (const double delta_s : {1e-5, 1e-4, 1e-3, 1e-2}) {
+      const auto c = discretize_seed000(motor.parameters, delta_s);
+      EXPECT_GT(c.a11, 0.0) << motor.name;
+      EXPECT_LT(std::abs(c.a11), 1.0) << motor.name << " delta " << delta_s;
+    }
+  }
+}
+
+TEST(ExactModel000, Eta1MatchesItsClosedForm) {
+  // q = I~^T J Phi~ is multiplied by det exp(A2 t) = exp(t tr A2), so with c = 0
+  // eta1 = mu (e^{delta tr A2} - 1) / tr A2, tr A2 = -alpha - gamma (paper motor, c = 0).
+  // With friction f = c/J the integral carries the weight e^{-f (delta - t)}:
+  // eta1 = mu e^{-f delta} delta phi1((tr A2 + f) delta).
+  for (const auto& motor : test::test_motors()) {
+    SCOPED_TRACE(motor.name);
+    const auto k = derive_seed000(motor.parameters);
+    const double trace = -k.alpha_per_s - k.gamma_per_s;
+    const double f = motor.parameters.friction_Nms / motor.parameters.J_kgm2;
+    const auto c = discretize_seed000(motor.parameters, kDelta_s);
+    const double closed =
+        k.mu_per_kgm2 * std::exp(-f * kDelta_s) * kDelta_s * phi1((trace + f) * kDelta_s);
+    EXPECT_NEAR(c.eta1, closed, kExpmTolerance * std::abs(closed));
+    if (f == 0.0) {
+      const double paper = k.mu_per_kgm2 * (std::exp(kDelta_s * trace) - 1.0) / trace;
+      // The paper's form cancels in e^x - 1 for small x: about 1e-16 / |x| relative.
+      EXPECT_NEAR(c.eta1, paper, 1e-16 / std::abs(kDelta_s * trace) * std::abs(paper) + kExpmTolerance * std::abs(paper));
+    }
+  }
+}
+
+TEST(ExactModel000, CompoundMatrixGivesTheMinorsOfTheExponential) {
+  // The derivation rests on C2(exp(A t)) = exp(A^[2] t): check it against the 2x2 minors.
+  for (const auto& motor : test::test_motors()) {
+    const Eigen::Matrix3d a = seed000_axis_generator(motor.parameters);
+    for (const double t : {1e-4, 1e-3, 2e-2}) {
+      const Eigen::Matrix3d e = (a * t).exp();
+      const Eigen::Matrix3d c = (additive_compound(a) * t).exp();
+      const int pairs[3][2] = {{0, 1}, {0, 2}, {1, 2}};
+      for (int r = 0; r < 3; ++r) {
+        for (int s = 0; s < 3; ++s) {
+          const auto [i, j] = pairs[r];
+          const auto [k, l] = pairs[s];
+          const double minor = e(i, k) * e(j, l) - e(i, l) * e(j, k);
+          EXPECT_NEAR(c(r, s), minor, kExpmTolerance * std::max(1.0, c.norm()))
+              << motor.name << " t " << t << " entry " << r << s;
+        }
+      }
+    }
+  }
+}
+
+TEST(ExactModel000, FrictionlessMechanicsReduceToThePaper) {
+  const auto& motor = test::test_motors().front();  // seed000: c = 0
+  const auto c = discretize_seed000(motor.parameters, kDelta_s);
+  const double J = motor.parameters.J_kgm2;
+  EXPECT_EQ(c.omega_decay, 1.0);
+  EXPECT_NEAR(c.omega_to_theta_s, kDelta_s, 1e-16 * kDelta_s);
+  EXPECT_NEAR(c.load_to_omega, -kDelta_s / J, 1e-15 * kDelta_s / J);
+  EXPECT_NEAR(c.load_to_theta, -kDelta_s * kDelta_s / (2 * J), 1e-15 * kDelta_s * kDelta_s / J);
+}
+
+TEST(ExactModel000, FloatPredictorStaysCloseToDouble) {
+  // The MCU build runs the predictor in float. Each output is a short sum of products of
+  // values of one magnitude, and the draws keep outputs away from zero, so the float result
+  // is within a few float ulp (6e-8) of double: bound 1e-6, i.e. about 16 ulp.
+  for (const auto& motor : test::test_motors()) {
+    const auto coefficients = discretize_seed000(motor.parameters, kDelta_s);
+    const ExactModel000<double> model_d(coefficients);
+    const ExactModel000<float> model_f(coefficients);
+    std::mt19937_64 rng(7);
+    for (int trial = 0; trial < 200; ++trial) {
+      const Draw d = random_draw(rng, motor);
+      RotorFrameState<float> xf{d.x.flux_r_AB_Wb.cast<float>(), d.x.i_s_AB_A.cast<float>(),
+                                float(d.x.omega_mech_rad_s), float(d.x.theta_mech_rad)};
+      const auto nd = model_d.predict(d.x, d.v_AB_V, d.load_Nm);
+      const auto nf = model_f.predict(xf, d.v_AB_V.cast<float>(), float(d.load_Nm));
+      EXPECT_LE(relative_error(nf.flux_r_AB_Wb.cast<double>(), nd.flux_r_AB_Wb), 1e-6);
+      EXPECT_LE(relative_error(nf.i_s_AB_A.cast<double>(), nd.i_s_AB_A), 1e-6);
+      EXPECT_LE(relative_error(double(nf.omega_mech_rad_s), nd.omega_mech_rad_s), 1e-6);
+      EXPECT_LE(relative_error(double(nf.theta_mech_rad), nd.theta_mech_rad), 1e-6);
+    }
+  }
+}
+
+}  // namespace
+}  // namespace imd::control
