@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 
 #include <cmath>
+#include <cstdlib>
 #include <iostream>
 #include <string>
 
@@ -75,7 +76,9 @@ ordered_json seed001_json(const MotorParameters& m, double T0_s) {
 /// A period must be a finite number in (0, 1] s; CLI11's PositiveNumber lets NaN through.
 const CLI::Validator kPeriod(
     [](std::string& text) -> std::string {
-      const double value = std::stod(text);
+      char* end = nullptr;
+      const double value = std::strtod(text.c_str(), &end);
+      if (end == text.c_str() || *end != '\0') return "must be a number, got " + text;
       if (!std::isfinite(value) || value <= 0.0 || value > 1.0) {
         return "must be a period in (0, 1] s, got " + text;
       }
@@ -97,10 +100,10 @@ int main(int argc, char** argv) {
       ->required();
   discretize
       ->add_option("--sample-period-s", delta_s, "Sample period delta of the paper-000 model")
-      ->check(CLI::Number & kPeriod)
+      ->check(kPeriod)
       ->capture_default_str();
   discretize->add_option("--control-period-s", T0_s, "Control period T0 of the paper-001 model")
-      ->check(CLI::Number & kPeriod)
+      ->check(kPeriod)
       ->capture_default_str();
 
   try {
