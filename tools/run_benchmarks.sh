@@ -1,0 +1,9 @@
+#!/bin/sh
+# Builds the host preset and runs the benchmarks whose figures docs/performance.md reports.
+set -eu
+cd "$(dirname "$0")/.."
+tools/install_deps.sh
+cmake --preset host >/dev/null
+cmake --build --preset host --target bench_plant
+build/bin/bench_plant --benchmark_repetitions=5 --benchmark_report_aggregates_only=true \
+  --benchmark_min_time=0.2 "$@"
