@@ -154,7 +154,7 @@ TEST(ExactModel000, CompoundMatrixGivesTheMinorsOfTheExponential) {
 }
 
 TEST(ExactModel000, FrictionlessMechanicsReduceToThePaper) {
-  const auto& motor = test::test_motors().front();  // seed000: c = 0
+  const test::TestMotor motor = test::test_motors().front();  // seed000: c = 0
   const auto c = discretize_seed000(motor.parameters, kDelta_s);
   const double J = motor.parameters.J_kgm2;
   EXPECT_EQ(c.omega_decay, 1.0);
