@@ -1,0 +1,65 @@
+#pragma once
+/// Clarke transforms (amplitude-invariant) and space-vector PWM with min-max zero-sequence
+/// injection. The linear range is |u_alphabeta| <= v_bus / sqrt(3). Tick context.
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <numbers>
+
+#include "control/frames.hpp"
+
+namespace imd::control {
+
+template <typename T>
+using PhaseValues = std::array<T, 3>;  ///< phases a, b, c
+
+/// alpha-beta from three phase values (their zero-sequence part is dropped).
+template <typename T>
+Vec2<T> clarke(const PhaseValues<T>& abc) noexcept {
+  return Vec2<T>((T(2) * abc[0] - abc[1] - abc[2]) / T(3), (abc[1] - abc[2]) / T(std::numbers::sqrt3));
+}
+
+/// Phase values (without zero sequence) from alpha-beta.
+template <typename T>
+PhaseValues<T> inverse_clarke(const Vec2<T>& ab) noexcept {
+  const T half_sqrt3 = T(std::numbers::sqrt3 / 2);
+  return {ab.x(), -ab.x() / T(2) + half_sqrt3 * ab.y(), -ab.x() / T(2) - half_sqrt3 * ab.y()};
+}
+
+/// Largest voltage-vector magnitude SVPWM produces without distortion.
+template <typename T>
+T svpwm_linear_limit_V(T v_bus_V) noexcept {
+  return v_bus_V / T(std::numbers::sqrt3);
+}
+
+template <typename T>
+struct SvpwmResult {
+  PhaseValues<T> duty{T(0.5), T(0.5), T(0.5)};  ///< high-side on-time fractions, in [0, 1]
+  bool clipped = false;                          ///< the request exceeded the linear range
+};
+
+/// Duties that make the average phase-to-neutral voltages equal to u (alpha-beta), with the
+/// zero sequence centring the phases. Beyond the linear range the vector is scaled down to it
+/// (direction kept). A non-positive or NaN bus gives 50 % duties and `clipped`.
+template <typename T>
+SvpwmResult<T> svpwm(Vec2<T> u_alphabeta_V, T v_bus_V) noexcept {
+  SvpwmResult<T> result;
+  if (!(v_bus_V > T(0))) {
+    result.clipped = true;
+    return result;
+  }
+  const T limit = svpwm_linear_limit_V(v_bus_V);
+  const T magnitude = u_alphabeta_V.norm();
+  if (!(magnitude <= limit)) {  // also catches NaN
+    result.clipped = true;
+    u_alphabeta_V = magnitude > limit ? Vec2<T>(u_alphabeta_V * (limit / magnitude)) : Vec2<T>::Zero();
+  }
+  const PhaseValues<T> v = inverse_clarke(u_alphabeta_V);
+  const T offset = -(std::max({v[0], v[1], v[2]}) + std::min({v[0], v[1], v[2]})) / T(2);
+  for (int phase = 0; phase < 3; ++phase) {
+    result.duty[phase] = std::clamp(T(0.5) + (v[phase] + offset) / v_bus_V, T(0), T(1));
+  }
+  return result;
+}
+
+}  // namespace imd::control
