@@ -1,0 +1,81 @@
+// Clarke transforms, SVPWM and the feasible-input disk.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+
+#include "control/input_disk.hpp"
+#include "control/svpwm.hpp"
+
+namespace imd::control {
+namespace {
+
+TEST(Clarke, RoundTripAndAmplitudeInvariance) {
+  const Vec2<double> u(120.0, -35.0);
+  const auto abc = inverse_clarke(u);
+  EXPECT_NEAR(abc[0] + abc[1] + abc[2], 0.0, 1e-12);
+  EXPECT_NEAR((clarke(abc) - u).norm(), 0.0, 1e-12);
+  // A balanced set of peak 10 gives a vector of magnitude 10 (amplitude-invariant).
+  const double a = 0.3;
+  const PhaseValues<double> balanced{10 * std::cos(a), 10 * std::cos(a - 2 * std::numbers::pi / 3),
+                                     10 * std::cos(a + 2 * std::numbers::pi / 3)};
+  EXPECT_NEAR(clarke(balanced).norm(), 10.0, 1e-12);
+}
+
+/// Average phase-to-neutral voltages of an inverter with these duties, as alpha-beta.
+Vec2<double> average_output(const PhaseValues<double>& duty, double v_bus_V) {
+  return clarke(PhaseValues<double>{duty[0] * v_bus_V, duty[1] * v_bus_V, duty[2] * v_bus_V});
+}
+
+TEST(Svpwm, ReproducesTheVectorUpToTheLinearLimit) {
+  const double v_bus = 311.0, limit = v_bus / std::sqrt(3.0);
+  for (int i = 0; i < 360; i += 7) {
+    const double angle = i * std::numbers::pi / 180;
+    const Vec2<double> u = 0.999 * limit * Vec2<double>(std::cos(angle), std::sin(angle));
+    const auto result = svpwm(u, v_bus);
+    EXPECT_FALSE(result.clipped);
+    for (double d : result.duty) {
+      EXPECT_GE(d, 0.0);
+      EXPECT_LE(d, 1.0);
+    }
+    EXPECT_NEAR((average_output(result.duty, v_bus) - u).norm(), 0.0, 1e-9);
+  }
+}
+
+TEST(Svpwm, ClipsBeyondTheLimitAndRejectsNonsense) {
+  const double v_bus = 311.0, limit = v_bus / std::sqrt(3.0);
+  const auto big = svpwm(Vec2<double>(400.0, 0.0), v_bus);
+  EXPECT_TRUE(big.clipped);
+  EXPECT_NEAR(average_output(big.duty, v_bus).norm(), limit, 1e-9);
+  const auto nan = svpwm(Vec2<double>(std::nan(""), 0.0), v_bus);
+  EXPECT_TRUE(nan.clipped);
+  for (double d : nan.duty) EXPECT_EQ(d, 0.5);
+  const auto no_bus = svpwm(Vec2<double>(10.0, 0.0), 0.0);
+  EXPECT_TRUE(no_bus.clipped);
+  for (double d : no_bus.duty) EXPECT_EQ(d, 0.5);
+}
+
+TEST(InputDisk, InscribedDiskLiesInBothAndTouchesBoth) {
+  const InputDisk<double> voltage{{10.0, 0.0}, 100.0}, current{{120.0, 30.0}, 60.0};
+  const auto lens = inscribed_disk(voltage, current);
+  const double s = (current.center_V - voltage.center_V).norm();
+  EXPECT_NEAR(lens.radius_V, (100.0 + 60.0 - s) / 2, 1e-12);
+  // Contained in both, and tangent to both boundaries.
+  EXPECT_NEAR((lens.center_V - voltage.center_V).norm() + lens.radius_V, 100.0, 1e-9);
+  EXPECT_NEAR((lens.center_V - current.center_V).norm() + lens.radius_V, 60.0, 1e-9);
+}
+
+TEST(InputDisk, NestedDisjointAndUnlimitedCases) {
+  const InputDisk<double> big{{0.0, 0.0}, 100.0}, small{{10.0, 0.0}, 5.0}, far{{300.0, 0.0}, 5.0};
+  EXPECT_EQ(inscribed_disk(big, small).radius_V, 5.0);
+  EXPECT_EQ(inscribed_disk(small, big).radius_V, 5.0);
+  const auto apart = inscribed_disk(big, far);  // no common point: the nearest point of `big`
+  EXPECT_EQ(apart.radius_V, 0.0);
+  EXPECT_NEAR((apart.center_V - Vec2<double>(100.0, 0.0)).norm(), 0.0, 1e-12);
+  EXPECT_EQ(inscribed_disk(InputDisk<double>{}, small).radius_V, 5.0);
+  EXPECT_TRUE(InputDisk<double>{}.unlimited());
+  EXPECT_EQ(big.clamp({200.0, 0.0}), Vec2<double>(100.0, 0.0));
+}
+
+}  // namespace
+}  // namespace imd::control
