@@ -1,6 +1,7 @@
 #include "control/exact_model_000.hpp"
 
 #include <Eigen/Core>
+#include <cmath>
 #include <unsupported/Eigen/MatrixFunctions>
 
 namespace imd::control {
@@ -46,15 +47,17 @@ ExactModel000Coefficients discretize_seed000(const MotorParameters& motor, doubl
   //   exp([M I 0; 0 -f I I; 0 0 0] delta) = [. Y Z; . . .; . . .],
   //   Y = int_0^delta exp(M u) exp(-f (delta - u)) du,
   //   Z = int_0^delta exp(M u) (1 - exp(-f (delta - u))) / f du  (-> (delta - u) as f -> 0).
+  // Built in the dimensionless time u/delta, so that the three blocks are of one size:
+  // exp([M delta, I, 0; 0, -f delta I, I; 0, 0, 0]) holds Y / delta and Z / delta^2.
   const Eigen::Matrix3d m = additive_compound(a3);
   Eigen::Matrix<double, 9, 9> big = Eigen::Matrix<double, 9, 9>::Zero();
-  big.block<3, 3>(0, 0) = m;
+  big.block<3, 3>(0, 0) = m * delta_s;
   big.block<3, 3>(0, 3).setIdentity();
-  big.block<3, 3>(3, 3) = -friction_per_s * Eigen::Matrix3d::Identity();
+  big.block<3, 3>(3, 3) = -friction_per_s * delta_s * Eigen::Matrix3d::Identity();
   big.block<3, 3>(3, 6).setIdentity();
-  const Eigen::Matrix<double, 9, 9> e9 = (big * delta_s).exp();
-  const Eigen::Matrix3d y = e9.block<3, 3>(0, 3);
-  const Eigen::Matrix3d z = e9.block<3, 3>(0, 6);
+  const Eigen::Matrix<double, 9, 9> e9 = big.exp();
+  const Eigen::Matrix3d y = delta_s * e9.block<3, 3>(0, 3);
+  const Eigen::Matrix3d z = delta_s * delta_s * e9.block<3, 3>(0, 6);
   // q = m00 I^T J Phi - m01 Phi^T J v - m02 I^T J v, with m the first row of exp(M t).
   c.eta1 = k.mu_per_kgm2 * y(0, 0);
   c.eta2 = -k.mu_per_kgm2 * y(0, 1);
@@ -70,6 +73,7 @@ ExactModel000Coefficients discretize_seed000(const MotorParameters& motor, doubl
   mech(1, 2) = -1.0 / motor.J_kgm2;
   const Eigen::Matrix3d e_mech = (mech * delta_s).exp();
   c.omega_decay = e_mech(1, 1);
+  c.omega_decay_minus_one = std::expm1(-friction_per_s * delta_s);
   c.omega_to_theta_s = e_mech(0, 1);
   c.load_to_omega = e_mech(1, 2);
   c.load_to_theta = e_mech(0, 2);

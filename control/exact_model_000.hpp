@@ -28,6 +28,7 @@ struct ExactModel000Coefficients {
   // Mechanical coefficients: exp(-c delta/J) and its integrals; 1, delta, -delta/J and
   // -delta^2/(2J) without friction.
   double omega_decay = 1.0;      ///< coefficient of w_k in w_{k+1}
+  double omega_decay_minus_one = 0.0;  ///< omega_decay - 1 without cancellation (expm1)
   double omega_to_theta_s = 0.0;  ///< coefficient of w_k in th_{k+1}
   double load_to_omega = 0.0;     ///< coefficient of C_L in w_{k+1}, rad/s per N m
   double load_to_theta = 0.0;     ///< coefficient of C_L in th_{k+1}, rad per N m
@@ -55,7 +56,16 @@ struct RotorFrameState {
   T theta_mech_rad = T(0);                 ///< mechanical rotor position
 };
 
-/// One-step predictor of the exact sampled model, in float or double.
+/// Changes of speed and position over one period.
+template <typename T>
+struct MechanicalIncrement {
+  T omega_mech_rad_s = T(0);  ///< w_{k+1} - w_k
+  T theta_mech_rad = T(0);    ///< th_{k+1} - th_k
+};
+
+/// One-step predictor of the exact sampled model, in float or double. The mechanical rows are
+/// evaluated as increments: the small terms (eta3 ~ 1e-9, kappa3 ~ 1e-13 for the paper motor)
+/// are not lost against w_k or th_k, and a caller may keep th wrapped.
 template <typename T>
 class ExactModel000 {
  public:
@@ -63,32 +73,43 @@ class ExactModel000 {
       : a11_(T(c.a11)), a12_(T(c.a12)), a21_(T(c.a21)), a22_(T(c.a22)), b1_(T(c.b1)),
         b2_(T(c.b2)), eta1_(T(c.eta1)), eta2_(T(c.eta2)), eta3_(T(c.eta3)),
         kappa1_(T(c.kappa1)), kappa2_(T(c.kappa2)), kappa3_(T(c.kappa3)),
-        omega_decay_(T(c.omega_decay)), omega_to_theta_s_(T(c.omega_to_theta_s)),
-        load_to_omega_(T(c.load_to_omega)), load_to_theta_(T(c.load_to_theta)) {}
+        omega_decay_minus_one_(T(c.omega_decay_minus_one)),
+        omega_to_theta_s_(T(c.omega_to_theta_s)), load_to_omega_(T(c.load_to_omega)),
+        load_to_theta_(T(c.load_to_theta)) {}
 
   /// State at step k+1 from the state at step k, the rotor-frame input v~_k (the voltage v of
   /// (2) rotated by -p th_k) and the load C_L,k held over the period. Tick context.
   RotorFrameState<T> predict(const RotorFrameState<T>& x, const Vec2<T>& v_AB_V,
                              T load_Nm) const noexcept {
-    const T torque_product = dot_J(x.i_s_AB_A, x.flux_r_AB_Wb);  // I^T J Phi
-    const T flux_input_product = dot_J(x.flux_r_AB_Wb, v_AB_V);  // Phi^T J v
-    const T current_input_product = dot_J(x.i_s_AB_A, v_AB_V);   // I^T J v
     RotorFrameState<T> next;
     next.flux_r_AB_Wb = a11_ * x.flux_r_AB_Wb + a12_ * x.i_s_AB_A + b1_ * v_AB_V;
     next.i_s_AB_A = a21_ * x.flux_r_AB_Wb + a22_ * x.i_s_AB_A + b2_ * v_AB_V;
-    next.omega_mech_rad_s = omega_decay_ * x.omega_mech_rad_s + eta1_ * torque_product +
+    const MechanicalIncrement<T> step = increment(x, v_AB_V, load_Nm);
+    next.omega_mech_rad_s = x.omega_mech_rad_s + step.omega_mech_rad_s;
+    next.theta_mech_rad = x.theta_mech_rad + step.theta_mech_rad;
+    return next;
+  }
+
+  /// Speed and position increments over the period. Tick context.
+  MechanicalIncrement<T> increment(const RotorFrameState<T>& x, const Vec2<T>& v_AB_V,
+                                   T load_Nm) const noexcept {
+    const T torque_product = dot_J(x.i_s_AB_A, x.flux_r_AB_Wb);  // I^T J Phi
+    const T flux_input_product = dot_J(x.flux_r_AB_Wb, v_AB_V);  // Phi^T J v
+    const T current_input_product = dot_J(x.i_s_AB_A, v_AB_V);   // I^T J v
+    MechanicalIncrement<T> step;
+    step.omega_mech_rad_s = omega_decay_minus_one_ * x.omega_mech_rad_s + eta1_ * torque_product +
                             eta2_ * flux_input_product + eta3_ * current_input_product +
                             load_to_omega_ * load_Nm;
-    next.theta_mech_rad = x.theta_mech_rad + omega_to_theta_s_ * x.omega_mech_rad_s +
-                          kappa1_ * torque_product + kappa2_ * flux_input_product +
-                          kappa3_ * current_input_product + load_to_theta_ * load_Nm;
-    return next;
+    step.theta_mech_rad = omega_to_theta_s_ * x.omega_mech_rad_s + kappa1_ * torque_product +
+                          kappa2_ * flux_input_product + kappa3_ * current_input_product +
+                          load_to_theta_ * load_Nm;
+    return step;
   }
 
  private:
   T a11_, a12_, a21_, a22_, b1_, b2_;
   T eta1_, eta2_, eta3_, kappa1_, kappa2_, kappa3_;
-  T omega_decay_, omega_to_theta_s_, load_to_omega_, load_to_theta_;
+  T omega_decay_minus_one_, omega_to_theta_s_, load_to_omega_, load_to_theta_;
 };
 
 }  // namespace imd::control

@@ -17,6 +17,7 @@ ExactModel001Coefficients discretize_seed001(const MotorParameters& motor, doubl
   c.flux_from_i_next_H = motor.Ls_H * k.sigma;
   c.torque_per_flux_A = kClarkeTorqueFactor * motor.pole_pairs;
   c.speed_decay = std::exp(-friction_per_s * T0_s);
+  c.speed_decay_minus_one = std::expm1(-friction_per_s * T0_s);
   // (e^{-aT} - e^{-bT}) / (J (b - a)) = e^{-aT} T phi1(-(b - a) T) / J with a = c/J, b = eta:
   // no cancellation when J eta is close to c.
   c.torque_to_speed =

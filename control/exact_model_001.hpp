@@ -24,6 +24,7 @@ struct ExactModel001Coefficients {
   double torque_per_flux_A = 0.0;    ///< k_T n_p: tau = k_T n_p i^T J phi, N m per Wb A
   double eta_per_s = 0.0;            ///< decay rate of the torque inside a period
   double speed_decay = 1.0;          ///< e^{-c T0 / J}
+  double speed_decay_minus_one = 0.0;  ///< e^{-c T0 / J} - 1 without cancellation (expm1)
   double torque_to_speed = 0.0;      ///< (e^{-c T0/J} - e^{-eta T0}) / (J eta - c), rad/s per N m
   double load_to_speed = 0.0;        ///< -(1 - e^{-c T0/J}) / c (-T0/J at c = 0), rad/s per N m
 };
@@ -42,7 +43,7 @@ class ExactModel001 {
   explicit ExactModel001(const ExactModel001Coefficients& c) noexcept
       : flux_decay_(T(c.flux_decay)), flux_from_i_now_H_(T(c.flux_from_i_now_H)),
         flux_from_i_next_H_(T(c.flux_from_i_next_H)), torque_per_flux_A_(T(c.torque_per_flux_A)),
-        speed_decay_(T(c.speed_decay)), torque_to_speed_(T(c.torque_to_speed)),
+        speed_decay_minus_one_(T(c.speed_decay_minus_one)), torque_to_speed_(T(c.torque_to_speed)),
         load_to_speed_(T(c.load_to_speed)) {}
 
   /// Stator flux at t_{k+1} after the current steps to i_{k+1}, equation (15).
@@ -57,15 +58,16 @@ class ExactModel001 {
     return torque_per_flux_A_ * dot_J(i_s_AB_A, flux_s_AB_Wb);
   }
 
-  /// Speed at t_{k+1} from the speed and torque at t_k and the held load, (17) with (18).
+  /// Speed at t_{k+1} from the speed and torque at t_k and the held load, (17) with (18),
+  /// evaluated as an increment so that float keeps the friction term.
   T next_speed(T omega_mech_rad_s, T torque_Nm, T load_Nm) const noexcept {
-    return speed_decay_ * omega_mech_rad_s + torque_to_speed_ * torque_Nm +
-           load_to_speed_ * load_Nm;
+    return omega_mech_rad_s + (speed_decay_minus_one_ * omega_mech_rad_s +
+                               torque_to_speed_ * torque_Nm + load_to_speed_ * load_Nm);
   }
 
  private:
   T flux_decay_, flux_from_i_now_H_, flux_from_i_next_H_, torque_per_flux_A_;
-  T speed_decay_, torque_to_speed_, load_to_speed_;
+  T speed_decay_minus_one_, torque_to_speed_, load_to_speed_;
 };
 
 }  // namespace imd::control

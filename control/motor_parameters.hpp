@@ -4,7 +4,8 @@
 /// Convention: the amplitude-invariant Clarke transform (alpha-beta quantities carry the phase
 /// peak values). With it the electromagnetic torque is (3/2) p (Lm/Lr) I^T J Phi, as in paper
 /// 000. Paper 001 writes its model with factor 1 (a power-invariant two-phase machine); the
-/// project keeps one convention and carries 3/2 into paper 001's torque (docs/conventions.md).
+/// project keeps one convention and carries 3/2 into paper 001's torque (docs/derivations.md,
+/// Conventions).
 #include <optional>
 #include <string_view>
 

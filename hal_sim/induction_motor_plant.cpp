@@ -63,9 +63,7 @@ void InductionMotorPlant::integrate_voltage_fed(const VoltageLaw& voltage_of_sta
   const auto rhs = [&](const StateVector& x) {
     return voltage_fed_derivative(x, voltage_of_state(x), load_Nm);
   };
-  StateVector x = pack(state_);
-  for (int i = 0; i < config_.rk4_substeps; ++i) x = rk4_step(x, h, rhs);
-  state_ = unpack(x);
+  state_ = unpack(integrate(pack(state_), h, config_.rk4_substeps, rhs));
   time_s_ += config_.period_s;
 }
 
@@ -106,8 +104,7 @@ void InductionMotorPlant::step_current_fed(const Vec2& i_s_AB_A, double load_Nm)
     return dx;
   };
   const double h = config_.period_s / config_.rk4_substeps;
-  StateVector x = pack(state_);
-  for (int i = 0; i < config_.rk4_substeps; ++i) x = rk4_step(x, h, rhs);
+  StateVector x = integrate(pack(state_), h, config_.rk4_substeps, rhs);
   x.segment<2>(2) = current_at(x(5));
   state_ = unpack(x);
   time_s_ += config_.period_s;

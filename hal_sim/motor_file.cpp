@@ -3,7 +3,9 @@
 #include <fmt/format.h>
 
 #include <cmath>
+#include <filesystem>
 #include <fstream>
+#include <system_error>
 
 #include "hal_sim/config_error.hpp"
 
@@ -56,6 +58,10 @@ int require_integer(const toml::table& motor, std::string_view key, std::string_
 }  // namespace
 
 toml::table parse_toml_file(const std::filesystem::path& path) {
+  std::error_code status;
+  if (std::filesystem::exists(path, status) && !std::filesystem::is_regular_file(path, status)) {
+    throw ConfigError(fmt::format("{}: not a regular file", path.string()));
+  }
   if (!std::ifstream(path).good()) {
     throw ConfigError(fmt::format("{}: cannot open file", path.string()));
   }

@@ -6,6 +6,8 @@
 #include <fstream>
 #include <string>
 
+#include <unistd.h>
+
 #include "hal_sim/config_error.hpp"
 #include "hal_sim/motor_file.hpp"
 #include "test_motors.hpp"
@@ -42,8 +44,13 @@ std::string error_of_text(const std::string& text) {
   return "(no error)";
 }
 
+/// A file in a directory of this test process alone, so that parallel runs of the suite (two
+/// build trees) cannot read each other's half-written files.
 std::filesystem::path write_temp(const std::string& name, const std::string& text) {
-  const auto path = std::filesystem::temp_directory_path() / name;
+  const auto directory = std::filesystem::temp_directory_path() /
+                         ("imd_test_motor_file_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(directory);
+  const auto path = directory / name;
   std::ofstream(path) << text;
   return path;
 }
@@ -113,6 +120,16 @@ TEST(MotorFile, MissingFileIsAClearError) {
     FAIL() << "no error";
   } catch (const ConfigError& error) {
     EXPECT_STREQ(error.what(), "/nonexistent/motor.toml: cannot open file");
+  }
+}
+
+TEST(MotorFile, DirectoryIsAClearError) {
+  const auto directory = write_temp("placeholder.toml", "").parent_path();
+  try {
+    load_motor_file(directory);
+    FAIL() << "no error";
+  } catch (const ConfigError& error) {
+    EXPECT_EQ(std::string(error.what()), directory.string() + ": not a regular file");
   }
 }
 

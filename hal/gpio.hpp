@@ -1,0 +1,16 @@
+#pragma once
+/// Digital lines by board-specific index: fault LED, enable input, and the like.
+#include <cstdint>
+
+namespace imd::hal {
+
+class Gpio {
+ public:
+  virtual ~Gpio() = default;
+  /// Drives an output line. Tick context.
+  virtual void write(uint8_t line, bool level) noexcept = 0;
+  /// Reads a line. Tick context.
+  virtual bool read(uint8_t line) const noexcept = 0;
+};
+
+}  // namespace imd::hal

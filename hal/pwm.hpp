@@ -1,0 +1,24 @@
+#pragma once
+/// Three-phase PWM output. Duties are high-side on-time fractions in [0, 1] of a center-aligned
+/// carrier. Disabled means every switch off: the inverter's safe state.
+#include <array>
+
+namespace imd::hal {
+
+using PhaseDuties = std::array<float, 3>;  ///< phases a, b, c
+
+class Pwm {
+ public:
+  virtual ~Pwm() = default;
+  /// Latches duties for the next carrier period. Tick context.
+  virtual void set_duties(const PhaseDuties& duty) noexcept = 0;
+  /// Starts switching with the last duties written. Tick context.
+  virtual void enable() noexcept = 0;
+  /// All switches off at once (the safe state). Tick context; also from fault handlers.
+  virtual void disable() noexcept = 0;
+  virtual bool enabled() const noexcept = 0;
+  /// Carrier period, fixed at configuration.
+  virtual float period_s() const noexcept = 0;
+};
+
+}  // namespace imd::hal

@@ -1,0 +1,117 @@
+#pragma once
+/// The simulated board's peripherals: each implements one HAL interface over state that the
+/// board (SimBoard) updates in lock-step. They hold no physics of their own.
+#include <cstdint>
+#include <deque>
+
+#include "hal/analog_inner_loop.hpp"
+#include "hal/can_bus.hpp"
+#include "hal/control_timer.hpp"
+#include "hal/current_adc.hpp"
+#include "hal/encoder.hpp"
+#include "hal/gpio.hpp"
+#include "hal/pwm.hpp"
+
+namespace imd::sim {
+
+class SimPwm final : public hal::Pwm {
+ public:
+  explicit SimPwm(float period_s) : period_s_(period_s) {}
+  void set_duties(const hal::PhaseDuties& duty) noexcept override { written_ = duty; }
+  void enable() noexcept override { enabled_ = true; }
+  void disable() noexcept override { enabled_ = false; }
+  bool enabled() const noexcept override { return enabled_; }
+  float period_s() const noexcept override { return period_s_; }
+  const hal::PhaseDuties& written() const noexcept { return written_; }
+
+ private:
+  float period_s_;
+  bool enabled_ = false;
+  hal::PhaseDuties written_{0.5f, 0.5f, 0.5f};
+};
+
+class SimEncoder final : public hal::Encoder {
+ public:
+  explicit SimEncoder(uint32_t counts_per_rev) : counts_per_rev_(counts_per_rev) {}
+  uint32_t count() const noexcept override { return count_; }
+  uint32_t counts_per_rev() const noexcept override { return counts_per_rev_; }
+  void latch(uint32_t count) noexcept { count_ = count; }
+
+ private:
+  uint32_t counts_per_rev_;
+  uint32_t count_ = 0;
+};
+
+class SimAdc final : public hal::CurrentAdc {
+ public:
+  explicit SimAdc(const hal::AdcScale& scale) : scale_(scale) {}
+  hal::AdcSample sample() const noexcept override { return sample_; }
+  hal::AdcScale scale() const noexcept override { return scale_; }
+  void latch(const hal::AdcSample& sample) noexcept { sample_ = sample; }
+
+ private:
+  hal::AdcScale scale_;
+  hal::AdcSample sample_{};
+};
+
+/// A CAN bus whose far end is the simulation: frames sent are collected for logging, frames
+/// injected arrive in order. Bounded queues, like a controller's mailboxes.
+class SimCan final : public hal::CanBus {
+ public:
+  static constexpr std::size_t kQueueDepth = 64;
+  bool try_send(const hal::CanFrame& frame) noexcept override;
+  bool try_receive(hal::CanFrame& frame) noexcept override;
+  /// Simulation side: deliver a frame to the firmware; false if its receive queue is full.
+  bool inject(const hal::CanFrame& frame);
+  /// Simulation side: take the frames the firmware sent since the last call.
+  std::deque<hal::CanFrame> take_sent();
+
+ private:
+  std::deque<hal::CanFrame> sent_, received_;
+};
+
+class SimGpio final : public hal::Gpio {
+ public:
+  static constexpr int kLines = 32;
+  void write(uint8_t line, bool level) noexcept override {
+    if (line < kLines) levels_[line] = level;
+  }
+  bool read(uint8_t line) const noexcept override { return line < kLines && levels_[line]; }
+
+ private:
+  bool levels_[kLines] = {};
+};
+
+/// Lock-step timer: the board calls the handler once per simulated period.
+class SimTimer final : public hal::ControlTimer {
+ public:
+  explicit SimTimer(uint32_t period_ns) : period_ns_(period_ns) {}
+  void start(hal::TickHandler& handler) noexcept override { handler_ = &handler; }
+  void stop() noexcept override { handler_ = nullptr; }
+  uint32_t period_ns() const noexcept override { return period_ns_; }
+  uint64_t tick_count() const noexcept override { return ticks_; }
+  uint64_t execution_clock_ns() const noexcept override;
+  /// Board side: runs the handler (if started) and counts the period.
+  void fire() noexcept;
+
+ private:
+  uint32_t period_ns_;
+  uint64_t ticks_ = 0;
+  hal::TickHandler* handler_ = nullptr;
+};
+
+/// The paper's analog inner-feedback device; the board reads the latest input.
+class SimAnalogInnerLoop final : public hal::AnalogInnerLoop {
+ public:
+  void set_input_AB_V(float v_A_V, float v_B_V) noexcept override {
+    v_A_V_ = v_A_V;
+    v_B_V_ = v_B_V;
+  }
+  float v_A_V() const noexcept { return v_A_V_; }
+  float v_B_V() const noexcept { return v_B_V_; }
+
+ private:
+  float v_A_V_ = 0.0f, v_B_V_ = 0.0f;
+};
+
+}  // namespace imd::sim
