@@ -4,7 +4,8 @@
 ///   th_{k+1} = th + T_w w + kappa1 q + (kappa2 Phi + kappa3 I)^T J v + T_L C_L
 ///   w_{k+1}  = d_w w + eta1 q + (eta2 Phi + eta3 I)^T J v + g_L C_L,     C_L constant,
 /// with q = I~^T J Phi~. The electrical terms come from the flux estimate, the measured current
-/// and the applied input. In filter form
+/// and the applied input. In filter form (predict at the end of a tick, correct at the start of
+/// the next)
 ///   x^-_k = A x_{k-1} + (electrical terms),   x_k = x^-_k + L wrap(th_meas,k - th^-_k),
 /// the error obeys e_k = (A - L C A) e_{k-1}, C = [1 0 0]; L places its three poles at
 /// exp(-bandwidth delta) (Ackermann). The angle is kept in [0, 2 pi) so that float keeps its
@@ -61,7 +62,8 @@ class EncoderObserver {
  public:
   EncoderObserver(const ExactModel000Coefficients& c, const EncoderObserverConfig& config)
       : omega_to_theta_(T(c.omega_to_theta_s)), load_to_theta_(T(c.load_to_theta)),
-        omega_decay_(T(c.omega_decay)), load_to_omega_(T(c.load_to_omega)), eta1_(T(c.eta1)),
+        omega_decay_minus_one_(T(c.omega_decay_minus_one)), load_to_omega_(T(c.load_to_omega)),
+        eta1_(T(c.eta1)),
         eta2_(T(c.eta2)), eta3_(T(c.eta3)), kappa1_(T(c.kappa1)), kappa2_(T(c.kappa2)),
         kappa3_(T(c.kappa3)) {
     const Eigen::Vector3d l = place_encoder_observer(c, config.bandwidth_rad_s);
@@ -80,27 +82,40 @@ class EncoderObserver {
     load_ = load_Nm;
   }
 
-  /// Predicts step k from k-1 (I~, flux estimate and applied v~ of step k-1), then corrects
-  /// with the measured angle of step k.
-  void update(const Vec2<T>& i_s_AB_A, const Vec2<T>& flux_r_AB_Wb, const Vec2<T>& v_AB_V,
-              T theta_measured_rad) noexcept {
+  /// Predicts step k+1 from step k, with I~_k, the flux estimate and the v~_k that acts over
+  /// the period. Tick context (end of tick k).
+  void predict(const Vec2<T>& i_s_AB_A, const Vec2<T>& flux_r_AB_Wb, const Vec2<T>& v_AB_V) noexcept {
     const T q = dot_J(i_s_AB_A, flux_r_AB_Wb);
     const T flux_input = dot_J(flux_r_AB_Wb, v_AB_V);
     const T current_input = dot_J(i_s_AB_A, v_AB_V);
-    const T theta = theta_ + omega_to_theta_ * omega_ + kappa1_ * q + kappa2_ * flux_input +
-                    kappa3_ * current_input + load_to_theta_ * load_;
-    const T omega = omega_decay_ * omega_ + eta1_ * q + eta2_ * flux_input + eta3_ * current_input +
-                    load_to_omega_ * load_;
-    const T innovation = wrap_pi(theta_measured_rad - theta);
-    theta_ = wrap_2pi(theta + gain_theta_ * innovation);
-    omega_ = omega + gain_omega_ * innovation;
+    const T theta_step = omega_to_theta_ * omega_ + kappa1_ * q + kappa2_ * flux_input +
+                         kappa3_ * current_input + load_to_theta_ * load_;
+    const T omega_step = omega_decay_minus_one_ * omega_ + eta1_ * q + eta2_ * flux_input +
+                         eta3_ * current_input + load_to_omega_ * load_;
+    theta_ = wrap_2pi(theta_ + theta_step);
+    omega_ = omega_ + omega_step;
+  }
+
+  /// Corrects the prediction with the measured angle of the new step. Tick context (start of
+  /// tick k+1).
+  void correct(T theta_measured_rad) noexcept {
+    const T innovation = wrap_pi(theta_measured_rad - theta_);
+    theta_ = wrap_2pi(theta_ + gain_theta_ * innovation);
+    omega_ = omega_ + gain_omega_ * innovation;
     load_ = load_ + gain_load_ * innovation;
+  }
+
+  /// predict() then correct().
+  void update(const Vec2<T>& i_s_AB_A, const Vec2<T>& flux_r_AB_Wb, const Vec2<T>& v_AB_V,
+              T theta_measured_rad) noexcept {
+    predict(i_s_AB_A, flux_r_AB_Wb, v_AB_V);
+    correct(theta_measured_rad);
   }
 
  private:
   static T wrap_2pi(T angle_rad) noexcept { return wrap_pi(angle_rad - T(std::numbers::pi)) + T(std::numbers::pi); }
 
-  T omega_to_theta_, load_to_theta_, omega_decay_, load_to_omega_;
+  T omega_to_theta_, load_to_theta_, omega_decay_minus_one_, load_to_omega_;
   T eta1_, eta2_, eta3_, kappa1_, kappa2_, kappa3_;
   T gain_theta_ = T(0), gain_omega_ = T(0), gain_load_ = T(0);
   T theta_ = T(0), omega_ = T(0), load_ = T(0);

@@ -43,6 +43,8 @@ class InductionMotorPlant {
   void set_state(const PlantState& state) noexcept { state_ = state; }
   double time_s() const noexcept { return time_s_; }
   const PlantConfig& config() const noexcept { return config_; }
+  int pole_pairs() const noexcept { return motor_.pole_pairs; }
+  const control::MotorParameters& motor() const noexcept { return motor_; }
 
   /// One period with the stator voltage u held (stationary frame).
   void step_voltage(const Vec2& u_s_alphabeta_V, double load_Nm) noexcept;

@@ -1,6 +1,7 @@
 #include "hal_sim/sim_peripherals.hpp"
 
 #include <chrono>
+#include <utility>
 
 namespace imd::sim {
 

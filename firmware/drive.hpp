@@ -1,0 +1,95 @@
+#pragma once
+/// The drive's control tick, run by the control timer at 10 kHz:
+///   sense (ADC, encoder) -> estimate (observers, rotation into the rotor frame) -> control
+///   (magnetizing current or DSMC, one-step prediction over the PWM latency) -> inner feedback
+///   (2) executed digitally -> limits -> SVPWM -> protection -> PWM write -> record.
+/// Start-up: ADC offset calibration with the PWM off, then magnetizing (B_k is singular at zero
+/// flux), then running. A fault turns the PWM off in the same tick and latches.
+/// T is the control arithmetic: float on the MCU, double on the host.
+#include <cstdint>
+
+#include "control/dsmc.hpp"
+#include "control/encoder_observer.hpp"
+#include "control/exact_model_000.hpp"
+#include "control/flux_observer.hpp"
+#include "control/load_estimator.hpp"
+#include "control/motor_parameters.hpp"
+#include "firmware/drive_config.hpp"
+#include "firmware/execution_stats.hpp"
+#include "firmware/reference_source.hpp"
+#include "firmware/state_oracle.hpp"
+#include "firmware/tick_record.hpp"
+#include "hal/analog_inner_loop.hpp"
+#include "hal/control_timer.hpp"
+#include "hal/current_adc.hpp"
+#include "hal/encoder.hpp"
+#include "hal/pwm.hpp"
+
+namespace imd::firmware {
+
+struct DrivePeripherals {
+  hal::Pwm& pwm;
+  hal::Encoder& encoder;
+  hal::CurrentAdc& adc;
+  hal::ControlTimer& timer;
+  hal::AnalogInnerLoop* analog_inner_loop = nullptr;  ///< only with config.analog_inner_loop
+};
+
+template <typename T>
+class Drive final : public hal::TickHandler {
+ public:
+  /// Wires the drive; no allocation after this. `oracle` (simulation only) gives ideal sensors.
+  Drive(const control::MotorParameters& motor, const DriveConfig& config,
+        const DrivePeripherals& peripherals, const ReferenceSource& references,
+        const StateOracle* oracle = nullptr);
+
+  void on_tick() noexcept override;
+
+  DriveState state() const noexcept { return state_; }
+  FaultCode fault() const noexcept { return fault_; }
+  const TickRecord& record() const noexcept { return record_; }
+  const ExecutionStats& execution() const noexcept { return execution_; }
+
+ private:
+  using Vec2 = control::Vec2<T>;
+
+  struct Estimate {
+    control::RotorFrameState<T> x;  ///< at this tick
+    T load_Nm = T(0);
+  };
+
+  bool calibrate_adc(const hal::AdcSample& sample) noexcept;
+  Estimate estimate(const hal::AdcSample& sample) noexcept;
+  control::InputDisk<T> feasible_inputs(const control::RotorFrameState<T>& x, T v_bus_V) const noexcept;
+  Vec2 magnetizing_input(const control::RotorFrameState<T>& x, T flux2_ref_Wb2,
+                         const control::InputDisk<T>& feasible) const noexcept;
+  Vec2 compensation_AB(const control::RotorFrameState<T>& x) const noexcept;
+  void trip(FaultCode code) noexcept;
+
+  DriveConfig config_;
+  DrivePeripherals hw_;
+  const ReferenceSource& references_;
+  const StateOracle* oracle_;
+
+  control::ExactModel000Coefficients coefficients_;
+  control::ExactModel000<T> model_;
+  control::Dsmc<T> dsmc_;
+  control::FluxObserver<T> flux_observer_;
+  control::EncoderObserver<T> encoder_observer_;
+  control::LoadEstimator<T> load_estimator_;
+  T sigma_H_, beta_per_H_, pole_pairs_, Lm_H_, a21_, a22_, b2_;
+
+  DriveState state_ = DriveState::calibrating;
+  FaultCode fault_ = FaultCode::none;
+  uint64_t magnetizing_start_tick_ = 0;
+  int calibration_count_ = 0;
+  int64_t calibration_sum_[3] = {0, 0, 0};
+  T offset_code_[3] = {T(0), T(0), T(0)};
+  uint32_t last_encoder_count_ = 0;
+  int64_t encoder_position_ = 0;  ///< counts within one revolution, [0, cpr)
+  Vec2 v_in_flight_V_ = Vec2::Zero();  ///< written last tick, acts over this period (latency 1)
+  TickRecord record_;
+  ExecutionStats execution_;
+};
+
+}  // namespace imd::firmware

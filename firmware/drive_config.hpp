@@ -1,0 +1,44 @@
+#pragma once
+/// Configuration of the drive application. In-class defaults are safe for the paper-000 motor;
+/// scenario and board files override them (validated on load).
+#include <limits>
+
+namespace imd::firmware {
+
+enum class ControllerKind { dsmc };
+
+struct DriveConfig {
+  double sample_period_s = 1e-4;              ///< control period delta
+  ControllerKind controller = ControllerKind::dsmc;
+  /// Drive the analog inner-feedback device (paper's hybrid scheme) instead of running (2)
+  /// digitally through the PWM.
+  bool analog_inner_loop = false;
+  /// Ticks between a duty write and its effect; the tick predicts that far with the exact
+  /// model (0 or 1).
+  int pwm_latency_ticks = 1;
+
+  // Limits.
+  bool voltage_limited = true;               ///< false only to reproduce the paper (no limit)
+  double modulation_margin = 0.95;           ///< share of the SVPWM linear range the law may use
+  double i_max_A = std::numeric_limits<double>::infinity();  ///< motor and inverter current limit
+
+  // Start-up.
+  int adc_calibration_ticks = 256;           ///< offset measurement with the PWM off; 0 skips it
+  double adc_offset_limit_A = 0.5;           ///< a larger measured offset is a fault
+  double magnetizing_current_A = 0.0;        ///< 0: sqrt(flux2_ref)/Lm, capped at 0.9 i_max
+  double magnetized_fraction = 0.95;         ///< running once |Phi^|^2 >= this * reference
+  double magnetizing_timeout_s = 2.0;
+
+  // Estimation.
+  double encoder_observer_bandwidth_rad_s = 400.0;
+  /// Use the paper's Section IV estimators (flux observer and load estimator on a measured
+  /// speed) instead of the encoder observer's speed and load.
+  bool section_iv_load_estimator = false;
+  double load_estimator_pole = 0.99;          ///< double pole of the error matrix (13)
+  double min_flux2_Wb2 = 1e-3;                ///< below it B_k counts as singular
+
+  // Protection (the full set comes with the drive application).
+  double overcurrent_trip_A = std::numeric_limits<double>::infinity();
+};
+
+}  // namespace imd::firmware

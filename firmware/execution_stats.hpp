@@ -1,0 +1,20 @@
+#pragma once
+/// Running mean and maximum of the tick's execution time.
+#include <cstdint>
+
+namespace imd::firmware {
+
+struct ExecutionStats {
+  uint64_t count = 0;
+  uint64_t total_ns = 0;
+  uint32_t max_ns = 0;
+
+  void add(uint32_t ns) noexcept {
+    ++count;
+    total_ns += ns;
+    if (ns > max_ns) max_ns = ns;
+  }
+  double mean_ns() const noexcept { return count ? double(total_ns) / double(count) : 0.0; }
+};
+
+}  // namespace imd::firmware

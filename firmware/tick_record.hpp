@@ -1,0 +1,37 @@
+#pragma once
+/// What one tick measured, estimated and commanded: the source of telemetry and of the
+/// simulation's CSV. Plain data, copied once per tick.
+#include <cstdint>
+
+namespace imd::firmware {
+
+enum class DriveState : uint8_t { calibrating, magnetizing, running, fault };
+
+enum class FaultCode : uint8_t {
+  none = 0,
+  adc_offset,            ///< offset out of range at start-up
+  overcurrent,
+  magnetizing_timeout,
+  non_finite,            ///< NaN or Inf in the duty path
+  singular_control,      ///< B_k singular while running
+};
+
+struct TickRecord {
+  uint64_t tick = 0;
+  DriveState state = DriveState::calibrating;
+  FaultCode fault = FaultCode::none;
+  // Estimates (rotor frame) at this tick.
+  double omega_est_rad_s = 0.0, theta_est_rad = 0.0, flux2_est_Wb2 = 0.0, load_est_Nm = 0.0;
+  double flux_est_A_Wb = 0.0, flux_est_B_Wb = 0.0;
+  double i_alpha_A = 0.0, i_beta_A = 0.0, v_bus_V = 0.0;
+  // References the law aimed at (for the step the input acts on).
+  double omega_ref_rad_s = 0.0, flux2_ref_Wb2 = 0.0;
+  // Command.
+  double v_A_V = 0.0, v_B_V = 0.0;           ///< v~ applied (after limiting)
+  double u_alpha_V = 0.0, u_beta_V = 0.0;    ///< stator voltage command
+  double discriminant = 0.0, c_k = 0.0, det_B = 0.0;
+  bool speed_saturated = false, flux_saturated = false, voltage_clipped = false;
+  uint32_t exec_ns = 0;
+};
+
+}  // namespace imd::firmware

@@ -1,0 +1,299 @@
+#include "hal_sim/scenario.hpp"
+
+#include <fmt/format.h>
+
+#include <cmath>
+#include <functional>
+#include <limits>
+#include <numbers>
+#include <set>
+#include <sstream>
+
+#include "hal_sim/config_error.hpp"
+#include "hal_sim/motor_file.hpp"
+
+namespace imd::sim {
+
+double SpeedProfile::at(double t_s) const noexcept {
+  if (kind == Kind::sine) {
+    return offset_rad_s + amplitude_rad_s * std::sin(2.0 * std::numbers::pi * frequency_Hz * t_s);
+  }
+  double value = 0.0;
+  for (std::size_t i = 0; i < times_s.size() && times_s[i] <= t_s; ++i) value = values_rad_s[i];
+  return value;
+}
+
+namespace {
+
+const std::set<std::string> kMotorKeys = {"Rs_Ohm", "Ls_H",   "Lm_H",       "Rr_Ohm",
+                                          "Lr_H",   "J_kgm2", "pole_pairs", "friction_Nms"};
+
+/// Reads keys by dotted path and remembers which it read, so that anything else in the
+/// document can be reported as unknown.
+class Reader {
+ public:
+  Reader(const toml::table& doc, std::string source) : doc_(doc), source_(std::move(source)) {}
+
+  [[noreturn]] void fail(std::string_view path, const std::string& what) const {
+    throw ConfigError(fmt::format("{}: {}: {}", source_, path, what));
+  }
+
+  const toml::node* find(std::string_view path) {
+    read_.insert(std::string(path));
+    return doc_.at_path(path).node();
+  }
+
+  double number(std::string_view path, std::optional<double> fallback) {
+    const toml::node* node = find(path);
+    if (node == nullptr) {
+      if (!fallback) fail(path, "missing key");
+      return *fallback;
+    }
+    if (const auto* real = node->as_floating_point()) return real->get();
+    if (const auto* integer = node->as_integer()) return static_cast<double>(integer->get());
+    fail(path, "must be a number");
+  }
+  double positive(std::string_view path, std::optional<double> fallback) {
+    const double value = number(path, fallback);
+    if (!(value > 0.0)) fail(path, fmt::format("= {}: must be > 0", value));
+    return value;
+  }
+  double non_negative(std::string_view path, std::optional<double> fallback) {
+    const double value = number(path, fallback);
+    if (!(value >= 0.0) || std::isinf(value)) fail(path, fmt::format("= {}: must be finite and >= 0", value));
+    return value;
+  }
+  int64_t integer(std::string_view path, int64_t fallback, int64_t low, int64_t high) {
+    const toml::node* node = find(path);
+    if (node == nullptr) return fallback;
+    const auto* value = node->as_integer();
+    if (value == nullptr) fail(path, "must be an integer");
+    if (value->get() < low || value->get() > high) {
+      fail(path, fmt::format("= {}: must be in {}..{}", value->get(), low, high));
+    }
+    return value->get();
+  }
+  bool boolean(std::string_view path, bool fallback) {
+    const toml::node* node = find(path);
+    if (node == nullptr) return fallback;
+    const auto* value = node->as_boolean();
+    if (value == nullptr) fail(path, "must be true or false");
+    return value->get();
+  }
+  std::string choice(std::string_view path, std::string fallback,
+                     std::initializer_list<std::string_view> allowed) {
+    const toml::node* node = find(path);
+    if (node == nullptr) return fallback;
+    const auto* value = node->as_string();
+    std::string list;
+    for (auto option : allowed) list += fmt::format("{}\"{}\"", list.empty() ? "" : ", ", option);
+    if (value == nullptr) fail(path, "must be one of " + list);
+    for (auto option : allowed) {
+      if (value->get() == option) return value->get();
+    }
+    fail(path, fmt::format("= \"{}\": must be one of {}", value->get(), list));
+  }
+  std::vector<double> numbers(std::string_view path) {
+    const toml::node* node = find(path);
+    if (node == nullptr) fail(path, "missing key");
+    const auto* array = node->as_array();
+    if (array == nullptr) fail(path, "must be an array of numbers");
+    std::vector<double> values;
+    for (const toml::node& element : *array) {
+      if (const auto* real = element.as_floating_point()) {
+        values.push_back(real->get());
+      } else if (const auto* integer = element.as_integer()) {
+        values.push_back(static_cast<double>(integer->get()));
+      } else {
+        fail(path, "must be an array of numbers");
+      }
+    }
+    return values;
+  }
+  /// Marks a whole table as read (its keys are checked elsewhere).
+  void accept_table(std::string_view path) { accepted_.insert(std::string(path)); }
+
+  /// Throws on the first key that nothing read.
+  void reject_unknown() const { walk(doc_, ""); }
+
+ private:
+  void walk(const toml::table& table, const std::string& prefix) const {
+    for (const auto& [key, node] : table) {
+      const std::string path = prefix.empty() ? std::string(key.str()) : prefix + "." + std::string(key.str());
+      if (accepted_.count(path)) continue;
+      if (const auto* child = node.as_table()) {
+        walk(*child, path);
+      } else if (!read_.count(path)) {
+        throw ConfigError(fmt::format("{}: unknown key {}", source_, path));
+      }
+    }
+  }
+
+  const toml::table& doc_;
+  std::string source_;
+  std::set<std::string> read_, accepted_;
+};
+
+/// Parses VALUE as a TOML value; a bare word that is not TOML becomes a string.
+toml::table parse_override_value(const std::string& text) {
+  try {
+    return toml::parse("value = " + text);
+  } catch (const toml::parse_error&) {
+    toml::table table;
+    table.insert("value", text);
+    return table;
+  }
+}
+
+void apply_override(toml::table& doc, const std::string& assignment, const std::string& source) {
+  const auto equals = assignment.find('=');
+  if (equals == std::string::npos || equals == 0) {
+    throw ConfigError(fmt::format("--set {}: expected table.key=VALUE", assignment));
+  }
+  const std::string path = assignment.substr(0, equals);
+  const std::string text = assignment.substr(equals + 1);
+  std::vector<std::string> parts;
+  std::stringstream stream(path);
+  for (std::string part; std::getline(stream, part, '.');) parts.push_back(part);
+  if (parts.size() < 2) throw ConfigError(fmt::format("--set {}: expected table.key=VALUE", assignment));
+  // The motor table admits free keys, so an override there must name a contract key or one
+  // the file has: a typo must not pass silently.
+  if (parts[0] == "motor" && !kMotorKeys.count(parts[1]) && !doc.at_path(path)) {
+    throw ConfigError(fmt::format("{}: --set {}: unknown key", source, path));
+  }
+  toml::table* table = &doc;
+  for (std::size_t i = 0; i + 1 < parts.size(); ++i) {
+    toml::node* child = table->get(parts[i]);
+    if (child == nullptr) {
+      table->insert(parts[i], toml::table{});
+      child = table->get(parts[i]);
+    }
+    table = child->as_table();
+    if (table == nullptr) throw ConfigError(fmt::format("{}: --set {}: {} is not a table", source, path, parts[i]));
+  }
+  toml::table parsed = parse_override_value(text);
+  table->insert_or_assign(parts.back(), std::move(*parsed.get("value")));
+}
+
+void read_speed_reference(Reader& r, Scenario& s) {
+  const std::string kind = r.choice("reference.speed.kind", "", {"sine", "steps"});
+  if (kind.empty()) r.fail("reference.speed.kind", "missing key");
+  if (kind == "sine") {
+    s.speed.kind = SpeedProfile::Kind::sine;
+    s.speed.amplitude_rad_s = r.number("reference.speed.amplitude_rad_s", std::nullopt);
+    s.speed.frequency_Hz = r.non_negative("reference.speed.frequency_Hz", std::nullopt);
+    s.speed.offset_rad_s = r.number("reference.speed.offset_rad_s", 0.0);
+  } else {
+    s.speed.kind = SpeedProfile::Kind::steps;
+    s.speed.times_s = r.numbers("reference.speed.times_s");
+    s.speed.values_rad_s = r.numbers("reference.speed.values_rad_s");
+    if (s.speed.times_s.size() != s.speed.values_rad_s.size()) {
+      r.fail("reference.speed.values_rad_s", "must have as many entries as times_s");
+    }
+    if (!std::is_sorted(s.speed.times_s.begin(), s.speed.times_s.end())) {
+      r.fail("reference.speed.times_s", "must be in increasing order");
+    }
+  }
+}
+
+void read_load(Reader& r, Scenario& s) {
+  const std::string kind = r.choice("load.kind", "constant", {"constant", "square", "steps"});
+  if (kind == "constant") {
+    s.load.kind = LoadProfile::Kind::constant;
+    s.load.value_Nm = r.number("load.value_Nm", 0.0);
+  } else if (kind == "square") {
+    s.load.kind = LoadProfile::Kind::square;
+    s.load.low_Nm = r.number("load.low_Nm", std::nullopt);
+    s.load.high_Nm = r.number("load.high_Nm", std::nullopt);
+    s.load.period_s = r.positive("load.period_s", std::nullopt);
+  } else {
+    s.load.kind = LoadProfile::Kind::steps;
+    s.load.times_s = r.numbers("load.times_s");
+    s.load.values_Nm = r.numbers("load.values_Nm");
+    if (s.load.times_s.size() != s.load.values_Nm.size()) {
+      r.fail("load.values_Nm", "must have as many entries as times_s");
+    }
+    if (!std::is_sorted(s.load.times_s.begin(), s.load.times_s.end())) {
+      r.fail("load.times_s", "must be in increasing order");
+    }
+  }
+}
+
+}  // namespace
+
+Scenario load_scenario(const std::filesystem::path& path, const std::vector<std::string>& overrides) {
+  toml::table doc = parse_toml_file(path);
+  const std::string source = path.string();
+  if (const toml::node* motor_file = doc.get("motor_file")) {
+    if (doc.get("motor") != nullptr) {
+      throw ConfigError(fmt::format("{}: give either motor_file or [motor], not both", source));
+    }
+    const auto* name = motor_file->as_string();
+    if (name == nullptr) throw ConfigError(fmt::format("{}: motor_file must be a string", source));
+    const std::filesystem::path motor_path = path.parent_path() / name->get();
+    const toml::table motor_doc = parse_toml_file(motor_path);
+    const toml::node* motor = motor_doc.get("motor");
+    if (motor == nullptr || !motor->is_table()) {
+      throw ConfigError(fmt::format("{}: missing table [motor]", motor_path.string()));
+    }
+    doc.insert("motor", *motor->as_table());
+    doc.erase("motor_file");
+  }
+  for (const std::string& assignment : overrides) apply_override(doc, assignment, source);
+
+  Scenario s;
+  s.source = source;
+  s.motor = parse_motor_table(doc, source);
+  Reader r(doc, source);
+  r.accept_table("motor");
+
+  s.sample_period_s = r.positive("drive.sample_period_s", 1e-4);
+  if (s.sample_period_s > 1e-2) r.fail("drive.sample_period_s", fmt::format("= {}: must be <= 0.01", s.sample_period_s));
+  s.controller = r.choice("drive.controller", "dsmc", {"dsmc"});
+  s.precision = r.choice("drive.precision", "double", {"double", "float"});
+
+  read_speed_reference(r, s);
+  s.flux2_Wb2 = r.positive("reference.flux.flux2_Wb2", std::nullopt);
+  read_load(r, s);
+
+  s.ideal_sensors = r.boolean("sensors.ideal", false);
+  s.encoder_cpr = static_cast<uint32_t>(r.integer("sensors.encoder_cpr", 8192, 4, 1 << 24));
+  s.adc.bits = static_cast<int>(r.integer("sensors.adc_bits", 12, 8, 16));
+  s.adc.full_scale_A = r.positive("sensors.adc_full_scale_A", 10.0);
+  s.adc.noise_A = r.non_negative("sensors.adc_noise_A", 0.0);
+  const double offset_A = r.number("sensors.adc_offset_A", 0.0);
+  s.adc.offset_A = {offset_A, -0.5 * offset_A, 0.25 * offset_A};
+  s.adc.bus_full_scale_V = r.positive("sensors.adc_bus_full_scale_V", 500.0);
+  s.adc.bus_noise_V = r.non_negative("sensors.adc_bus_noise_V", 0.0);
+
+  s.v_bus_V = r.positive("inverter.v_bus_V", 311.0);
+  if (s.v_bus_V >= s.adc.bus_full_scale_V) {
+    r.fail("inverter.v_bus_V", fmt::format("= {}: must be below sensors.adc_bus_full_scale_V", s.v_bus_V));
+  }
+  s.i_max_A = r.positive("inverter.i_max_A", std::numeric_limits<double>::infinity());
+
+  s.section_iv = r.boolean("observers.section_iv", false);
+  s.encoder_bandwidth_rad_s = r.positive("observers.encoder_bandwidth_rad_s", 400.0);
+  s.load_estimator_pole = r.number("observers.load_estimator_pole", 0.99);
+  if (!(s.load_estimator_pole > 0.0 && s.load_estimator_pole < 1.0)) {
+    r.fail("observers.load_estimator_pole", fmt::format("= {}: must be in (0, 1)", s.load_estimator_pole));
+  }
+
+  s.duration_s = r.positive("simulation.duration_s", 1.0);
+  s.substeps = static_cast<int>(r.integer("simulation.substeps", 10, 1, 10000));
+  s.inner_feedback = r.choice("simulation.inner_feedback", "digital", {"digital", "ideal_analog"}) == "digital"
+                         ? InnerFeedback::digital
+                         : InnerFeedback::ideal_analog;
+  s.pwm_latency_ticks = static_cast<int>(r.integer("simulation.pwm_latency_ticks", 1, 0, 1));
+  s.seed = static_cast<uint64_t>(r.integer("simulation.seed", 1, 0, std::numeric_limits<int64_t>::max()));
+  s.initial_flux2_Wb2 = r.non_negative("simulation.initial_flux2_Wb2", 0.0);
+
+  s.settle_s = r.non_negative("metrics.settle_s", 0.5);
+  if (s.settle_s >= s.duration_s) {
+    r.fail("metrics.settle_s", fmt::format("= {}: must be below simulation.duration_s", s.settle_s));
+  }
+  r.reject_unknown();
+  return s;
+}
+
+}  // namespace imd::sim

@@ -1,0 +1,70 @@
+#pragma once
+/// Scenario files: TOML describing a motor, the drive, references, load, sensors, inverter and
+/// the simulation (docs/scenarios.md). Every key is validated; an unknown key is an error.
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "control/motor_parameters.hpp"
+#include "hal_sim/load_profile.hpp"
+#include "hal_sim/sim_board.hpp"
+
+namespace imd::sim {
+
+struct SpeedProfile {
+  enum class Kind { sine, steps };
+  Kind kind = Kind::sine;
+  double amplitude_rad_s = 0.0, frequency_Hz = 0.0, offset_rad_s = 0.0;  ///< sine
+  std::vector<double> times_s, values_rad_s;  ///< steps: values_rad_s[i] from times_s[i]; 0 before
+  double at(double t_s) const noexcept;
+};
+
+struct Scenario {
+  std::string source;  ///< file name, for messages and the summary
+  control::MotorParameters motor;
+
+  // [drive]
+  double sample_period_s = 1e-4;
+  std::string controller = "dsmc";
+  std::string precision = "double";  ///< control arithmetic: "double" or "float"
+
+  // [reference.speed], [reference.flux]
+  SpeedProfile speed;
+  double flux2_Wb2 = 0.2;
+
+  LoadProfile load;
+
+  // [sensors]
+  bool ideal_sensors = false;
+  uint32_t encoder_cpr = 8192;
+  AdcModelConfig adc;
+
+  // [inverter]
+  double v_bus_V = 311.0;
+  double i_max_A = 0.0;  ///< inf: no current limit
+
+  // [observers]
+  bool section_iv = false;  ///< paper's flux observer and load estimator on the ideal speed
+  double encoder_bandwidth_rad_s = 400.0;
+  double load_estimator_pole = 0.99;
+
+  // [simulation]
+  double duration_s = 1.0;
+  int substeps = 10;
+  InnerFeedback inner_feedback = InnerFeedback::digital;
+  int pwm_latency_ticks = 1;
+  uint64_t seed = 1;
+  double initial_flux2_Wb2 = 0.0;  ///< start magnetized at rest with this squared flux
+
+  // [metrics]
+  double settle_s = 0.5;
+};
+
+/// Loads a scenario. `overrides` are "table.key=VALUE" strings (VALUE in TOML syntax; a bare
+/// word is taken as a string), applied after any motor_file has been merged in. Throws
+/// ConfigError naming the file, the key and the value.
+Scenario load_scenario(const std::filesystem::path& path,
+                       const std::vector<std::string>& overrides = {});
+
+}  // namespace imd::sim

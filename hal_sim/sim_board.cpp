@@ -1,0 +1,54 @@
+#include "hal_sim/sim_board.hpp"
+
+#include <cmath>
+
+#include "control/svpwm.hpp"
+
+namespace imd::sim {
+
+SimBoard::SimBoard(const control::MotorParameters& motor, const SimBoardConfig& config)
+    : config_(config),
+      plant_(motor, {config.period_s, config.substeps}),
+      adc_model_(config.adc, config.seed),
+      pwm_(static_cast<float>(config.period_s)),
+      encoder_(config.encoder_cpr),
+      adc_(adc_model_.scale()),
+      timer_(static_cast<uint32_t>(std::lround(config.period_s * 1e9))) {}
+
+void SimBoard::latch_sensors() {
+  const PlantState& s = plant_.state();
+  const auto i_abc = control::inverse_clarke(s.i_s_alphabeta_A);
+  adc_.latch(adc_model_.convert({i_abc[0], i_abc[1], i_abc[2]}, config_.v_bus_V));
+  encoder_.latch(encoder_count(s.theta_mech_rad, config_.encoder_cpr));
+}
+
+void SimBoard::run_tick() {
+  latch_sensors();
+  timer_.fire();
+  const double load_now_Nm = load_Nm();
+  // What the firmware wrote this tick acts now (no latency) or from the next tick.
+  const Vec2 written_analog(analog_.v_A_V(), analog_.v_B_V());
+  if (config_.pwm_latency_ticks == 0) {
+    active_duty_ = pwm_.written();
+    active_analog_input_V_ = written_analog;
+  }
+  if (!pwm_.enabled()) {
+    applied_voltage_V_.setZero();
+    plant_.step_current_fed(Vec2::Zero(), load_now_Nm);
+  } else if (config_.inner_feedback == InnerFeedback::ideal_analog) {
+    const PlantState& s = plant_.state();
+    const double p = plant_.pole_pairs();
+    applied_voltage_V_ =
+        control::Rotation<double>::from_angle(p * s.theta_mech_rad).apply(active_analog_input_V_);
+    plant_.step_analog_feedback(active_analog_input_V_, load_now_Nm);
+  } else {
+    applied_voltage_V_ = inverter_output_V(active_duty_, config_.v_bus_V);
+    plant_.step_voltage(applied_voltage_V_, load_now_Nm);
+  }
+  if (config_.pwm_latency_ticks != 0) {
+    active_duty_ = pwm_.written();
+    active_analog_input_V_ = written_analog;
+  }
+}
+
+}  // namespace imd::sim

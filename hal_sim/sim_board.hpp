@@ -1,0 +1,82 @@
+#pragma once
+/// The simulated board: the motor plant behind every HAL interface, advanced in lock-step with
+/// the control timer. One call of run_tick() is one control period:
+///   1. the ADC and encoder latch the plant state at t_k;
+///   2. the timer runs the firmware's tick handler;
+///   3. the plant integrates [t_k, t_{k+1}] with what the inverter (or the analog inner-loop
+///      device) applies: with one tick of latency, the duties written at tick k act from k+1.
+/// With the PWM disabled the inverter is off and the stator currents are zero (the free-
+/// wheeling transient, a fraction of a millisecond, is not modelled).
+#include <cstdint>
+
+#include "control/motor_parameters.hpp"
+#include "hal_sim/induction_motor_plant.hpp"
+#include "hal_sim/load_profile.hpp"
+#include "hal_sim/sensor_models.hpp"
+#include "hal_sim/sim_peripherals.hpp"
+
+namespace imd::sim {
+
+enum class InnerFeedback {
+  digital,       ///< the firmware runs (2) sampled and held; the PWM drives the motor
+  ideal_analog,  ///< (2) is evaluated continuously by the analog device (paper's scheme)
+};
+
+struct SimBoardConfig {
+  double period_s = 1e-4;
+  int substeps = 10;                 ///< RK4 steps per period
+  int pwm_latency_ticks = 1;         ///< 0 or 1
+  InnerFeedback inner_feedback = InnerFeedback::digital;
+  double v_bus_V = 311.0;
+  uint32_t encoder_cpr = 8192;
+  AdcModelConfig adc;
+  uint64_t seed = 1;
+};
+
+class SimBoard {
+ public:
+  /// Requires valid parameters and config (the scenario loader validates them).
+  SimBoard(const control::MotorParameters& motor, const SimBoardConfig& config);
+
+  hal::Pwm& pwm() noexcept { return pwm_; }
+  hal::Encoder& encoder() noexcept { return encoder_; }
+  hal::CurrentAdc& adc() noexcept { return adc_; }
+  hal::CanBus& can() noexcept { return can_; }
+  hal::Gpio& gpio() noexcept { return gpio_; }
+  hal::ControlTimer& timer() noexcept { return timer_; }
+  hal::AnalogInnerLoop& analog_inner_loop() noexcept { return analog_; }
+  SimCan& can_side() noexcept { return can_; }
+
+  InductionMotorPlant& plant() noexcept { return plant_; }
+  const InductionMotorPlant& plant() const noexcept { return plant_; }
+  const SimBoardConfig& config() const noexcept { return config_; }
+
+  void set_load_profile(const LoadProfile& profile) { load_ = profile; }
+  /// Load torque over the current period (held, hypothesis H1).
+  double load_Nm() const noexcept { return load_.at(plant_.time_s()); }
+  /// Stator voltage the plant saw over the last period (alpha-beta); for the analog device, the
+  /// value at the start of the period.
+  const Vec2& applied_voltage_V() const noexcept { return applied_voltage_V_; }
+
+  void run_tick();
+
+ private:
+  void latch_sensors();
+
+  SimBoardConfig config_;
+  InductionMotorPlant plant_;
+  AdcModel adc_model_;
+  LoadProfile load_;
+  SimPwm pwm_;
+  SimEncoder encoder_;
+  SimAdc adc_;
+  SimCan can_;
+  SimGpio gpio_;
+  SimTimer timer_;
+  SimAnalogInnerLoop analog_;
+  hal::PhaseDuties active_duty_{0.5f, 0.5f, 0.5f};
+  Vec2 active_analog_input_V_ = Vec2::Zero();
+  Vec2 applied_voltage_V_ = Vec2::Zero();
+};
+
+}  // namespace imd::sim

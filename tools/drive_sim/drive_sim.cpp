@@ -1,0 +1,152 @@
+// drive_sim: runs a scenario of the drive firmware on the simulated board.
+//
+//   drive_sim SCENARIO.toml [--duration-s S] [--csv PATH] [--summary-json PATH]
+//             [--plot PATH.png] [--set table.key=VALUE]...
+//
+// Prints the summary (JSON) on standard output. Exit codes: 0 success, 2 bad input (command
+// line or scenario file), 1 an output could not be written.
+#include <CLI/CLI.hpp>
+#include <fmt/format.h>
+#include <fmt/os.h>
+#include <nlohmann/json.hpp>
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <iostream>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <unistd.h>
+
+#include "hal_sim/config_error.hpp"
+#include "hal_sim/scenario.hpp"
+#include "tools/drive_sim/scenario_run.hpp"
+
+namespace {
+
+constexpr int kExitBadInput = 2;
+constexpr int kExitOutputFailed = 1;
+
+constexpr const char* kCsvHeader =
+    "t_s,omega_mech_rad_s,omega_ref_rad_s,omega_est_rad_s,flux2_Wb2,flux2_ref_Wb2,flux2_est_Wb2,"
+    "load_Nm,load_est_Nm,i_alpha_A,i_beta_A,v_alpha_V,v_beta_V,discriminant,c_k,"
+    "flux_A_Wb,flux_B_Wb,flux_A_est_Wb,flux_B_est_Wb,theta_mech_rad,theta_est_rad,torque_Nm,"
+    "state,saturated\n";
+
+nlohmann::ordered_json summary_json(const imd::sim::Scenario& s, const imd::sim::Summary& r) {
+  nlohmann::ordered_json faults = nlohmann::ordered_json::array();
+  for (const auto& f : r.faults) faults.push_back({{"code", f.code}, {"detected_at_s", f.detected_at_s}});
+  return {{"scenario", s.source},
+          {"precision", s.precision},
+          {"settle_s", s.settle_s},
+          {"speed_rms_err_rad_s", r.speed_rms_err_rad_s},
+          {"speed_max_err_rad_s", r.speed_max_err_rad_s},
+          {"flux2_rms_err_Wb2", r.flux2_rms_err_Wb2},
+          {"flux2_max_err_Wb2", r.flux2_max_err_Wb2},
+          {"load_est_rms_err_Nm", r.load_est_rms_err_Nm},
+          {"i_peak_A", r.i_peak_A},
+          {"i_peak_total_A", r.i_peak_total_A},
+          {"i_max_A", std::isfinite(s.i_max_A) ? nlohmann::ordered_json(s.i_max_A) : nlohmann::ordered_json(nullptr)},
+          {"saturated_fraction", r.saturated_fraction},
+          {"running_from_s", r.running_from_s},
+          {"ticks", r.ticks},
+          {"simulated_s", r.simulated_s},
+          {"wall_time_s", r.wall_time_s},
+          {"simulated_s_per_wall_s", r.wall_time_s > 0 ? r.simulated_s / r.wall_time_s : 0.0},
+          {"tick_exec_ns_mean", r.tick_exec_ns_mean},
+          {"tick_exec_ns_max", r.tick_exec_ns_max},
+          {"faults", faults}};
+}
+
+std::string plot_script() {
+  return (std::filesystem::path(IMD_SOURCE_DIR) / "tools" / "plot_seed000.py").string();
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"Runs the drive firmware on the simulated board for a scenario file."};
+  std::string scenario_path, csv_path, summary_path, plot_path;
+  std::optional<double> duration_s;
+  std::vector<std::string> overrides;
+  app.add_option("scenario", scenario_path, "Scenario file (TOML)")->required();
+  app.add_option("--duration-s", duration_s, "Simulated duration, overrides simulation.duration_s")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--csv", csv_path, "Write one row per tick to this CSV file");
+  app.add_option("--summary-json", summary_path, "Write the summary to this JSON file");
+  app.add_option("--plot", plot_path, "Write the paper's Figures 1-5 to this PNG (needs python3-matplotlib)");
+  app.add_option("--set", overrides, "Override a scenario key: table.key=VALUE (repeatable)");
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& error) {
+    const int code = app.exit(error);
+    return code == 0 ? 0 : kExitBadInput;
+  }
+  if (duration_s) overrides.push_back(fmt::format("simulation.duration_s={}", *duration_s));
+
+  imd::sim::Scenario scenario;
+  try {
+    scenario = imd::sim::load_scenario(scenario_path, overrides);
+  } catch (const imd::sim::ConfigError& error) {
+    std::cerr << "drive_sim: " << error.what() << '\n';
+    return kExitBadInput;
+  }
+
+  // The plot is drawn from the CSV; without --csv a temporary file serves.
+  const bool temporary_csv = csv_path.empty() && !plot_path.empty();
+  if (temporary_csv) csv_path = (std::filesystem::temp_directory_path() / fmt::format("drive_sim_{}.csv", ::getpid())).string();
+  std::optional<fmt::ostream> csv;
+  try {
+    if (!csv_path.empty()) {
+      csv.emplace(fmt::output_file(csv_path));
+      csv->print("{}", kCsvHeader);
+    }
+  } catch (const std::system_error& error) {
+    std::cerr << "drive_sim: cannot write " << csv_path << ": " << error.what() << '\n';
+    return kExitOutputFailed;
+  }
+
+  imd::sim::RunCallbacks callbacks;
+  if (csv) {
+    callbacks.row = [&](const imd::sim::SimRow& r) {
+      csv->print("{:.6f},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.6g},{:.6g},{:.6g},{:.6g},"
+                 "{:.6g},{:.6g},{:.8g},{:.8g},{:.8g},{:.8g},{:.8g},{:.8g},{:.8g},{:.8g},{:.6g},{},{}\n",
+                 r.t_s, r.omega_mech_rad_s, r.omega_ref_rad_s, r.omega_est_rad_s, r.flux2_Wb2,
+                 r.flux2_ref_Wb2, r.flux2_est_Wb2, r.load_Nm, r.load_est_Nm, r.i_alpha_A, r.i_beta_A,
+                 r.v_alpha_V, r.v_beta_V, r.discriminant, r.c_k, r.flux_A_Wb, r.flux_B_Wb,
+                 r.flux_A_est_Wb, r.flux_B_est_Wb, r.theta_mech_rad, r.theta_est_rad, r.torque_Nm,
+                 r.state, r.saturated ? 1 : 0);
+    };
+  }
+  callbacks.progress = [&](double simulated_s, double wall_s) {
+    std::fprintf(stderr, "\rdrive_sim: %.2f / %.2f s simulated, %.1f s wall", simulated_s,
+                 scenario.duration_s, wall_s);
+  };
+  const imd::sim::Summary summary = imd::sim::run_scenario(scenario, callbacks);
+  if (summary.wall_time_s > 1.0) std::fprintf(stderr, "\n");
+  if (csv) csv->close();
+
+  const std::string text = summary_json(scenario, summary).dump(2);
+  std::cout << text << '\n';
+  if (!summary_path.empty()) {
+    std::FILE* file = std::fopen(summary_path.c_str(), "w");
+    if (file == nullptr || std::fprintf(file, "%s\n", text.c_str()) < 0 || std::fclose(file) != 0) {
+      std::cerr << "drive_sim: cannot write " << summary_path << '\n';
+      return kExitOutputFailed;
+    }
+  }
+  if (!plot_path.empty()) {
+    const std::string command = fmt::format("/usr/bin/python3 '{}' '{}' --out '{}' --settle-s {}",
+                                            plot_script(), csv_path, plot_path, scenario.settle_s);
+    const int status = std::system(command.c_str());
+    if (temporary_csv) std::filesystem::remove(csv_path);
+    if (status != 0) {
+      std::cerr << "drive_sim: plotting failed (" << command << ")\n";
+      return kExitOutputFailed;
+    }
+  }
+  return 0;
+}

@@ -1,0 +1,191 @@
+#include "tools/drive_sim/scenario_run.hpp"
+
+#include <chrono>
+#include <cmath>
+
+#include "control/frames.hpp"
+#include "firmware/drive.hpp"
+#include "hal_sim/sim_board.hpp"
+
+namespace imd::sim {
+namespace {
+
+class ScenarioReferences final : public firmware::ReferenceSource {
+ public:
+  explicit ScenarioReferences(const Scenario& s) : s_(s) {}
+  firmware::Reference at_tick(uint64_t k) const noexcept override {
+    return {s_.speed.at(double(k) * s_.sample_period_s), s_.flux2_Wb2};
+  }
+
+ private:
+  const Scenario& s_;
+};
+
+/// The plant's state in the rotor frame: the "ideal sensors" of paper 000, Section III.
+class PlantOracle final : public firmware::StateOracle {
+ public:
+  explicit PlantOracle(const SimBoard& board) : board_(board) {}
+  firmware::TrueState true_state() const noexcept override {
+    const PlantState& s = board_.plant().state();
+    const auto rotor = control::Rotation<double>::from_angle(board_.plant().pole_pairs() * s.theta_mech_rad);
+    const Vec2 flux = rotor.apply_inverse(s.flux_r_alphabeta_Wb);
+    const Vec2 current = rotor.apply_inverse(s.i_s_alphabeta_A);
+    return {flux.x(), flux.y(), current.x(), current.y(), s.omega_mech_rad_s, s.theta_mech_rad,
+            board_.load_Nm()};
+  }
+
+ private:
+  const SimBoard& board_;
+};
+
+const char* fault_name(firmware::FaultCode code) {
+  switch (code) {
+    case firmware::FaultCode::none: return "none";
+    case firmware::FaultCode::adc_offset: return "adc_offset";
+    case firmware::FaultCode::overcurrent: return "overcurrent";
+    case firmware::FaultCode::magnetizing_timeout: return "magnetizing_timeout";
+    case firmware::FaultCode::non_finite: return "non_finite";
+    case firmware::FaultCode::singular_control: return "singular_control";
+  }
+  return "unknown";
+}
+
+SimBoardConfig board_config(const Scenario& s) {
+  SimBoardConfig c;
+  c.period_s = s.sample_period_s;
+  c.substeps = s.substeps;
+  c.pwm_latency_ticks = s.pwm_latency_ticks;
+  c.inner_feedback = s.inner_feedback;
+  c.v_bus_V = s.v_bus_V;
+  c.encoder_cpr = s.encoder_cpr;
+  c.adc = s.adc;
+  c.seed = s.seed;
+  return c;
+}
+
+firmware::DriveConfig drive_config(const Scenario& s) {
+  firmware::DriveConfig c;
+  c.sample_period_s = s.sample_period_s;
+  c.analog_inner_loop = s.inner_feedback == InnerFeedback::ideal_analog;
+  c.pwm_latency_ticks = s.pwm_latency_ticks;
+  c.i_max_A = s.i_max_A;
+  c.overcurrent_trip_A = 1.5 * s.i_max_A;
+  c.adc_calibration_ticks = s.ideal_sensors ? 0 : 256;
+  c.section_iv_load_estimator = s.section_iv;
+  c.encoder_observer_bandwidth_rad_s = s.encoder_bandwidth_rad_s;
+  c.load_estimator_pole = s.load_estimator_pole;
+  return c;
+}
+
+template <typename T>
+Summary run(const Scenario& s, const RunCallbacks& callbacks) {
+  SimBoard board(s.motor, board_config(s));
+  board.set_load_profile(s.load);
+  if (s.initial_flux2_Wb2 > 0.0) {  // magnetized steady state at rest: Phi = Lm I, along A
+    PlantState start;
+    start.flux_r_alphabeta_Wb = {std::sqrt(s.initial_flux2_Wb2), 0.0};
+    start.i_s_alphabeta_A = {std::sqrt(s.initial_flux2_Wb2) / s.motor.Lm_H, 0.0};
+    board.plant().set_state(start);
+  }
+  const ScenarioReferences references(s);
+  const PlantOracle oracle(board);
+  firmware::Drive<T> drive(s.motor, drive_config(s),
+                           {board.pwm(), board.encoder(), board.adc(), board.timer(),
+                            &board.analog_inner_loop()},
+                           references, s.ideal_sensors ? &oracle : nullptr);
+  board.timer().start(drive);
+
+  Summary summary;
+  const auto wall_start = std::chrono::steady_clock::now();
+  auto last_progress = wall_start;
+  const auto ticks = static_cast<uint64_t>(std::llround(s.duration_s / s.sample_period_s));
+  const control::MotorParameters& m = s.motor;
+  double speed_sq = 0, flux_sq = 0, load_sq = 0;
+  uint64_t measured = 0, saturated = 0;
+  firmware::FaultCode last_fault = firmware::FaultCode::none;
+  for (uint64_t k = 0; k < ticks; ++k) {
+    const double t_s = double(k) * s.sample_period_s;
+    const PlantState truth = board.plant().state();
+    const double load_Nm = board.load_Nm();
+    const double torque_Nm = board.plant().torque_Nm();
+    board.run_tick();
+    const firmware::TickRecord& rec = drive.record();
+
+    SimRow row;
+    row.t_s = t_s;
+    row.omega_mech_rad_s = truth.omega_mech_rad_s;
+    row.omega_ref_rad_s = s.speed.at(t_s);
+    row.omega_est_rad_s = rec.omega_est_rad_s;
+    const auto rotor = control::Rotation<double>::from_angle(m.pole_pairs * truth.theta_mech_rad);
+    const Vec2 flux_AB = rotor.apply_inverse(truth.flux_r_alphabeta_Wb);
+    row.flux_A_Wb = flux_AB.x();
+    row.flux_B_Wb = flux_AB.y();
+    row.flux2_Wb2 = flux_AB.squaredNorm();
+    row.flux2_ref_Wb2 = s.flux2_Wb2;
+    row.flux2_est_Wb2 = rec.flux2_est_Wb2;
+    row.flux_A_est_Wb = rec.flux_est_A_Wb;
+    row.flux_B_est_Wb = rec.flux_est_B_Wb;
+    row.load_Nm = load_Nm;
+    row.load_est_Nm = rec.load_est_Nm;
+    row.i_alpha_A = truth.i_s_alphabeta_A.x();
+    row.i_beta_A = truth.i_s_alphabeta_A.y();
+    row.v_alpha_V = board.applied_voltage_V().x();
+    row.v_beta_V = board.applied_voltage_V().y();
+    row.discriminant = rec.discriminant;
+    row.c_k = rec.c_k;
+    row.theta_mech_rad = truth.theta_mech_rad;
+    row.theta_est_rad = rec.theta_est_rad;
+    row.torque_Nm = torque_Nm;
+    row.state = static_cast<int>(rec.state);
+    row.saturated = rec.speed_saturated || rec.flux_saturated || rec.voltage_clipped;
+
+    const double current_A = truth.i_s_alphabeta_A.norm();
+    summary.i_peak_total_A = std::max(summary.i_peak_total_A, current_A);
+    if (summary.running_from_s < 0 && rec.state == firmware::DriveState::running) summary.running_from_s = t_s;
+    if (rec.fault != last_fault) {
+      summary.faults.push_back({fault_name(rec.fault), t_s});
+      last_fault = rec.fault;
+    }
+    if (t_s > s.settle_s) {
+      const double speed_err = row.omega_mech_rad_s - row.omega_ref_rad_s;
+      const double flux_err = row.flux2_Wb2 - row.flux2_ref_Wb2;
+      speed_sq += speed_err * speed_err;
+      flux_sq += flux_err * flux_err;
+      load_sq += (row.load_est_Nm - row.load_Nm) * (row.load_est_Nm - row.load_Nm);
+      summary.speed_max_err_rad_s = std::max(summary.speed_max_err_rad_s, std::abs(speed_err));
+      summary.flux2_max_err_Wb2 = std::max(summary.flux2_max_err_Wb2, std::abs(flux_err));
+      summary.i_peak_A = std::max(summary.i_peak_A, current_A);
+      saturated += row.saturated ? 1 : 0;
+      ++measured;
+    }
+    if (callbacks.row) callbacks.row(row);
+    if (callbacks.progress && (k & 1023) == 0) {
+      const auto now = std::chrono::steady_clock::now();
+      if (now - last_progress > std::chrono::seconds(1)) {
+        last_progress = now;
+        callbacks.progress(t_s, std::chrono::duration<double>(now - wall_start).count());
+      }
+    }
+  }
+  summary.ticks = ticks;
+  summary.simulated_s = double(ticks) * s.sample_period_s;
+  summary.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+  if (measured > 0) {
+    summary.speed_rms_err_rad_s = std::sqrt(speed_sq / double(measured));
+    summary.flux2_rms_err_Wb2 = std::sqrt(flux_sq / double(measured));
+    summary.load_est_rms_err_Nm = std::sqrt(load_sq / double(measured));
+    summary.saturated_fraction = double(saturated) / double(measured);
+  }
+  summary.tick_exec_ns_mean = drive.execution().mean_ns();
+  summary.tick_exec_ns_max = drive.execution().max_ns;
+  return summary;
+}
+
+}  // namespace
+
+Summary run_scenario(const Scenario& scenario, const RunCallbacks& callbacks) {
+  return scenario.precision == "float" ? run<float>(scenario, callbacks)
+                                       : run<double>(scenario, callbacks);
+}
+
+}  // namespace imd::sim
