@@ -12,7 +12,10 @@
 ///   * saturation keeps the sign of the unsaturated control in both channels;
 ///   * the bounds w0_alpha, w0_beta are intervals derived each period from the feasible input
 ///     disk (InputDisk), flux first; with an unlimited disk there is no saturation;
-///   * viscous friction enters xi1 through omega_decay (1 in the paper).
+///   * viscous friction enters xi1 through omega_decay (1 in the paper);
+///   * an optional reaching law S_{k+1} = lambda S_k per channel (lambda = 0 is the paper's
+///     deadbeat law S_{k+1} = 0), so that a board with a quantized encoder is not driven
+///     bang-bang by measurement noise.
 #include <cmath>
 #include <limits>
 
@@ -26,6 +29,9 @@ struct DsmcConfig {
   /// B_k is refused (singular) when |det B_k| is below its value for a pure magnetizing state
   /// at this squared flux: det B_k ~ 2 b1 eta2 a11 |Phi~|^2.
   double min_flux2_Wb2 = 1e-3;
+  /// Reaching laws e_{k+1} = pole e_k of the speed and squared-flux errors, in [0, 1).
+  double speed_reaching_pole = 0.0;
+  double flux_reaching_pole = 0.0;
 };
 
 template <typename T>
@@ -34,7 +40,9 @@ struct DsmcInput {
   Vec2<T> i_s_AB_A = Vec2<T>::Zero();      ///< stator current, rotor frame
   T omega_mech_rad_s = T(0);               ///< speed (estimate)
   T load_Nm = T(0);                        ///< load torque C_L (estimate)
+  T omega_ref_rad_s = T(0);                ///< speed reference at k (for the reaching law)
   T omega_ref_next_rad_s = T(0);           ///< speed reference at k+1
+  T flux2_ref_Wb2 = T(0);                  ///< squared flux reference at k (reaching law)
   T flux2_ref_next_Wb2 = T(0);             ///< squared flux reference at k+1
   InputDisk<T> feasible;                   ///< inputs v~ the limits allow
 };
@@ -61,7 +69,8 @@ class Dsmc {
   Dsmc(const ExactModel000Coefficients& c, const DsmcConfig& config) noexcept
       : a11_(T(c.a11)), a12_(T(c.a12)), b1_(T(c.b1)), eta1_(T(c.eta1)), eta2_(T(c.eta2)),
         eta3_(T(c.eta3)), omega_decay_(T(c.omega_decay)), load_to_omega_(T(c.load_to_omega)),
-        min_det_(T(std::abs(2.0 * c.b1 * c.eta2 * c.a11) * config.min_flux2_Wb2)) {}
+        min_det_(T(std::abs(2.0 * c.b1 * c.eta2 * c.a11) * config.min_flux2_Wb2)),
+        speed_pole_(T(config.speed_reaching_pole)), flux_pole_(T(config.flux_reaching_pole)) {}
 
   /// One step of the law. Tick context.
   DsmcOutput<T> step(const DsmcInput<T>& in) const noexcept {
@@ -81,14 +90,17 @@ class Dsmc {
     if (!(std::abs(det) >= min_det_)) return out;  // also refuses NaN
     out.status = DsmcStatus::ok;
 
-    out.w_eq_alpha = in.omega_ref_next_rad_s - xi1 - load_to_omega_ * in.load_Nm;
+    // Targets of the next step: the reference plus what the reaching law leaves of the error.
+    const T omega_target = in.omega_ref_next_rad_s + speed_pole_ * (in.omega_mech_rad_s - in.omega_ref_rad_s);
+    const T flux2_target = in.flux2_ref_next_Wb2 + flux_pole_ * (flux.squaredNorm() - in.flux2_ref_Wb2);
+    out.w_eq_alpha = omega_target - xi1 - load_to_omega_ * in.load_Nm;
     const T lambda11 = lambda1.squaredNorm(), lambda22 = lambda2.squaredNorm();
     const T lambda12 = lambda1.dot(lambda2);
     const T b1_over_det2 = b1_ * b1_ / (det * det);
     const auto flux_control = [&](T w_alpha, DsmcOutput<T>& o) {
       const T a = b1_over_det2 * lambda11;
       const T b = T(1) - T(2) * b1_over_det2 * w_alpha * lambda12;
-      const T c = xi2 - in.flux2_ref_next_Wb2 + b1_over_det2 * w_alpha * w_alpha * lambda22;
+      const T c = xi2 - flux2_target + b1_over_det2 * w_alpha * w_alpha * lambda22;
       o.c_k = c;
       o.discriminant = b * b - T(4) * a * c;
       return o.discriminant >= T(0) ? stable_root(a, b, c, o.discriminant) : -b / (T(2) * a);
@@ -163,6 +175,7 @@ class Dsmc {
 
   T a11_, a12_, b1_, eta1_, eta2_, eta3_, omega_decay_, load_to_omega_;
   T min_det_;
+  T speed_pole_, flux_pole_;
 };
 
 }  // namespace imd::control

@@ -28,12 +28,14 @@ Drive<T>::Drive(const control::MotorParameters& motor, const DriveConfig& config
       oracle_(oracle),
       coefficients_(control::discretize_seed000(motor, config.sample_period_s)),
       model_(coefficients_),
-      dsmc_(coefficients_, control::DsmcConfig{config.min_flux2_Wb2}),
+      dsmc_(coefficients_, control::DsmcConfig{config.min_flux2_Wb2, config.speed_reaching_pole,
+                                               config.flux_reaching_pole}),
       flux_observer_(coefficients_),
       encoder_observer_(coefficients_, {config.encoder_observer_bandwidth_rad_s}),
       load_estimator_(coefficients_,
                       control::place_load_estimator(coefficients_, config.load_estimator_pole,
-                                                    config.load_estimator_pole)) {
+                                                    config.load_estimator_pole)),
+      speed_ramp_(config.max_accel_rad_s2, config.sample_period_s) {
   const control::Seed000Constants k = control::derive_seed000(motor);
   sigma_H_ = T(k.sigma_H);
   beta_per_H_ = T(k.beta_per_H);
@@ -130,7 +132,8 @@ control::InputDisk<T> Drive<T>::feasible_inputs(const control::RotorFrameState<T
                T(config_.modulation_margin) * control::svpwm_linear_limit_V(v_bus_V)};
   }
   if (std::isfinite(config_.i_max_A)) {
-    current = {-(a21_ * x.flux_r_AB_Wb + a22_ * x.i_s_AB_A) / b2_, T(config_.i_max_A) / b2_};
+    current = {-(a21_ * x.flux_r_AB_Wb + a22_ * x.i_s_AB_A) / b2_,
+               T(config_.current_margin * config_.i_max_A) / b2_};
   }
   return control::inscribed_disk(voltage, current);
 }
@@ -178,7 +181,15 @@ void Drive<T>::on_tick() noexcept {
     control::RotorFrameState<T> x = e.x;
     if (latency) x = model_.predict(e.x, v_in_flight_V_, e.load_Nm);
     x.theta_mech_rad = control::wrap_pi(x.theta_mech_rad);
-    const Reference ref = references_.at_tick(k + (latency ? 2 : 1));
+    // References at x's step and the step after, the speed through the ramp (which follows
+    // the estimate until the drive runs).
+    if (state_ != DriveState::running) speed_ramp_.reset(e.x.omega_mech_rad_s);
+    const T ramp_k1 = speed_ramp_.next(speed_ramp_.value(), T(references_.at_tick(k + 1).omega_mech_rad_s));
+    Reference ref_now = references_.at_tick(k + (latency ? 1 : 0));
+    Reference ref = references_.at_tick(k + (latency ? 2 : 1));
+    ref_now.omega_mech_rad_s = double(latency ? ramp_k1 : speed_ramp_.value());
+    ref.omega_mech_rad_s = double(latency ? speed_ramp_.next(ramp_k1, T(ref.omega_mech_rad_s)) : ramp_k1);
+    speed_ramp_.reset(ramp_k1);
     const control::InputDisk<T> feasible = feasible_inputs(x, v_bus_V);
     Vec2 v = Vec2::Zero();
     if (state_ == DriveState::magnetizing) {
@@ -198,7 +209,9 @@ void Drive<T>::on_tick() noexcept {
       in.i_s_AB_A = x.i_s_AB_A;
       in.omega_mech_rad_s = x.omega_mech_rad_s;
       in.load_Nm = e.load_Nm;
+      in.omega_ref_rad_s = T(ref_now.omega_mech_rad_s);
       in.omega_ref_next_rad_s = T(ref.omega_mech_rad_s);
+      in.flux2_ref_Wb2 = T(ref_now.flux2_Wb2);
       in.flux2_ref_next_Wb2 = T(ref.flux2_Wb2);
       in.feasible = feasible;
       const control::DsmcOutput<T> out = dsmc_.step(in);

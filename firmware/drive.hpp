@@ -17,6 +17,7 @@
 #include "firmware/drive_config.hpp"
 #include "firmware/execution_stats.hpp"
 #include "firmware/reference_source.hpp"
+#include "firmware/speed_ramp.hpp"
 #include "firmware/state_oracle.hpp"
 #include "firmware/tick_record.hpp"
 #include "hal/analog_inner_loop.hpp"
@@ -77,6 +78,7 @@ class Drive final : public hal::TickHandler {
   control::FluxObserver<T> flux_observer_;
   control::EncoderObserver<T> encoder_observer_;
   control::LoadEstimator<T> load_estimator_;
+  SpeedRamp<T> speed_ramp_;
   T sigma_H_, beta_per_H_, pole_pairs_, Lm_H_, a21_, a22_, b2_;
 
   DriveState state_ = DriveState::calibrating;

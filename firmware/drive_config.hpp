@@ -17,10 +17,16 @@ struct DriveConfig {
   /// model (0 or 1).
   int pwm_latency_ticks = 1;
 
+  // Control law.
+  double max_accel_rad_s2 = std::numeric_limits<double>::infinity();  ///< speed reference ramp
+  double speed_reaching_pole = 0.0;          ///< e_{k+1} = pole e_k; 0 is the paper's deadbeat law
+  double flux_reaching_pole = 0.0;
+
   // Limits.
   bool voltage_limited = true;               ///< false only to reproduce the paper (no limit)
   double modulation_margin = 0.95;           ///< share of the SVPWM linear range the law may use
   double i_max_A = std::numeric_limits<double>::infinity();  ///< motor and inverter current limit
+  double current_margin = 0.95;              ///< share of i_max the law may plan for
 
   // Start-up.
   int adc_calibration_ticks = 256;           ///< offset measurement with the PWM off; 0 skips it

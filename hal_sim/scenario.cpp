@@ -251,6 +251,12 @@ Scenario load_scenario(const std::filesystem::path& path, const std::vector<std:
   if (s.sample_period_s > 1e-2) r.fail("drive.sample_period_s", fmt::format("= {}: must be <= 0.01", s.sample_period_s));
   s.controller = r.choice("drive.controller", "dsmc", {"dsmc"});
   s.precision = r.choice("drive.precision", "double", {"double", "float"});
+  s.max_accel_rad_s2 = r.positive("drive.max_accel_rad_s2", std::numeric_limits<double>::infinity());
+  for (auto [key, value] : {std::pair{"drive.speed_reaching_pole", &s.speed_reaching_pole},
+                            std::pair{"drive.flux_reaching_pole", &s.flux_reaching_pole}}) {
+    *value = r.number(key, 0.0);
+    if (!(*value >= 0.0 && *value < 1.0)) r.fail(key, fmt::format("= {}: must be in [0, 1)", *value));
+  }
 
   read_speed_reference(r, s);
   s.flux2_Wb2 = r.positive("reference.flux.flux2_Wb2", std::nullopt);

@@ -28,6 +28,9 @@ struct Scenario {
   double sample_period_s = 1e-4;
   std::string controller = "dsmc";
   std::string precision = "double";  ///< control arithmetic: "double" or "float"
+  double max_accel_rad_s2 = 0.0;     ///< speed reference ramp; inf: none
+  double speed_reaching_pole = 0.0;  ///< 0: the paper's deadbeat law
+  double flux_reaching_pole = 0.0;
 
   // [reference.speed], [reference.flux]
   SpeedProfile speed;

@@ -69,6 +69,9 @@ firmware::DriveConfig drive_config(const Scenario& s) {
   c.analog_inner_loop = s.inner_feedback == InnerFeedback::ideal_analog;
   c.pwm_latency_ticks = s.pwm_latency_ticks;
   c.i_max_A = s.i_max_A;
+  c.max_accel_rad_s2 = s.max_accel_rad_s2;
+  c.speed_reaching_pole = s.speed_reaching_pole;
+  c.flux_reaching_pole = s.flux_reaching_pole;
   c.overcurrent_trip_A = 1.5 * s.i_max_A;
   c.adc_calibration_ticks = s.ideal_sensors ? 0 : 256;
   c.section_iv_load_estimator = s.section_iv;
