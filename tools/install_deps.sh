@@ -1,9 +1,11 @@
 #!/bin/sh
-# Installs the Debian 12 packages the build, the tests and the main job need, if any is missing.
-# Idempotent: when everything is present it changes nothing and needs no network.
+# Installs the Debian 12 packages the build and the tests need (and, with --plot, those the
+# main job's plots need) if any is missing. Idempotent: when everything is present it changes
+# nothing and needs no network.
 set -eu
 packages="g++ cmake ninja-build libeigen3-dev libtomlplusplus-dev libcli11-dev nlohmann-json3-dev
 libfmt-dev libgtest-dev libbenchmark-dev"
+if [ "${1:-}" = "--plot" ]; then packages="$packages python3 python3-numpy python3-matplotlib"; fi
 
 missing=""
 for package in $packages; do

@@ -1,0 +1,100 @@
+// The seed-000 scenarios end to end: the firmware's tick on the simulated board, as drive_sim
+// runs them. These are the acceptance checks of docs/results.md.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <vector>
+
+#include "control/exact_model_000.hpp"
+#include "hal_sim/scenario.hpp"
+#include "test_motors.hpp"
+#include "tools/drive_sim/scenario_run.hpp"
+
+namespace imd::sim {
+namespace {
+
+Scenario scenario(const std::string& name, const std::vector<std::string>& overrides = {}) {
+  return load_scenario(test::source_path("hal_sim/scenarios/" + name), overrides);
+}
+
+TEST(Seed000Paper, TrueStateAndLoadGiveDeadbeatTracking) {
+  // On the exact model with ideal sensors and the analog inner feedback, the law puts speed and
+  // squared flux on their references one period after each step: what is left is rounding and
+  // the RK4 error of the plant (substeps = 20), far below 1e-6.
+  const Summary r = run_scenario(scenario("seed000_paper.toml"));
+  EXPECT_TRUE(r.faults.empty());
+  EXPECT_EQ(r.running_from_s, 0.0);
+  EXPECT_LE(r.speed_max_err_rad_s, 1e-6);
+  EXPECT_LE(r.flux2_max_err_Wb2, 1e-6);
+  std::printf("paper: speed max err %.2e rad/s, flux2 max err %.2e Wb^2 after 10 ms\n",
+              r.speed_max_err_rad_s, r.flux2_max_err_Wb2);
+}
+
+TEST(Seed000Paper, SectionIvObserversConverge) {
+  // The paper's flux observer starts from zero; the drive holds the magnetizing current until
+  // the estimate reaches 95 % of the reference, and ramps the speed reference (2000 rad/s^2) to
+  // catch up with the sine afterwards.
+  const Scenario s = scenario("seed000_paper.toml", {"observers.section_iv=true",
+                                                      "drive.max_accel_rad_s2=2000",
+                                                      "metrics.settle_s=0.5"});
+  const double a11 = control::discretize_seed000(s.motor, s.sample_period_s).a11;
+  std::vector<SimRow> rows;
+  rows.reserve(80001);
+  const Summary r = run_scenario(s, {[&](const SimRow& row) { rows.push_back(row); }, {}});
+  ASSERT_TRUE(r.faults.empty());
+
+  // Flux estimate: e_k = a11^k e_0 while the motor is held magnetized (the first 1000 ticks
+  // are inside the magnetizing phase). The observer copies the exact model, so only rounding
+  // separates them: 1e-9 of e_0.
+  const double e0_A = rows[0].flux_A_Wb - rows[0].flux_A_est_Wb;
+  const double e0_B = rows[0].flux_B_Wb - rows[0].flux_B_est_Wb;
+  for (int k = 0; k <= 1000; ++k) {
+    const double expected = std::pow(a11, k);
+    ASSERT_NEAR(rows[k].flux_A_Wb - rows[k].flux_A_est_Wb, expected * e0_A, 1e-9 * std::abs(e0_A)) << k;
+    ASSERT_NEAR(rows[k].flux_B_Wb - rows[k].flux_B_est_Wb, expected * e0_B, 1e-9 * std::abs(e0_A)) << k;
+  }
+  // Load: within 2 % of the 1 N m step, 100 ms after each step (square wave, 1 s period).
+  for (double step_s = 0.5; step_s < s.duration_s; step_s += 0.5) {
+    const auto k = static_cast<std::size_t>(std::lround((step_s + 0.1) / s.sample_period_s));
+    EXPECT_NEAR(rows[k].load_est_Nm, rows[k].load_Nm, 0.02 * 1.0) << "step at " << step_s << " s";
+  }
+}
+
+TEST(Seed000Realistic, MeetsTheTrackingAndLimitTargets) {
+  const Scenario s = scenario("seed000_realistic.toml");
+  bool all_finite = true;
+  const Summary r = run_scenario(s, {[&](const SimRow& row) {
+                                       all_finite = all_finite && std::isfinite(row.v_alpha_V) &&
+                                                    std::isfinite(row.v_beta_V);
+                                     },
+                                     {}});
+  EXPECT_TRUE(r.faults.empty());
+  EXPECT_TRUE(all_finite);  // nothing non-finite ever reached the inverter
+  EXPECT_LE(r.speed_rms_err_rad_s, 0.5);
+  EXPECT_LE(r.flux2_rms_err_Wb2, 0.02 * s.flux2_Wb2);
+  EXPECT_LE(r.i_peak_total_A, s.i_max_A);  // the whole run, start-up included
+  EXPECT_GE(r.saturated_fraction, 0.0);
+  EXPECT_LE(r.saturated_fraction, 1.0);
+  std::printf("realistic: speed rms %.4f rad/s, flux2 rms %.3e Wb^2, i peak %.3f A, saturated %.3f\n",
+              r.speed_rms_err_rad_s, r.flux2_rms_err_Wb2, r.i_peak_total_A, r.saturated_fraction);
+}
+
+TEST(Seed000Realistic, FloatControlStaysCloseToDouble) {
+  // Float rounding changes the trajectory the way a different noise seed does; in double the
+  // RMS metrics move by up to +-9 % between seeds 1..4 (docs/results.md), so 10 % is the bound
+  // to meet. The single-sample maximum is not compared: it moves by +-20 % between seeds.
+  const Summary d = run_scenario(scenario("seed000_realistic.toml"));
+  const Summary f = run_scenario(scenario("seed000_realistic.toml", {"drive.precision=\"float\""}));
+  ASSERT_TRUE(f.faults.empty());
+  const auto within = [](double value, double reference) {
+    return std::abs(value - reference) <= 0.1 * std::abs(reference);
+  };
+  EXPECT_TRUE(within(f.speed_rms_err_rad_s, d.speed_rms_err_rad_s)) << f.speed_rms_err_rad_s;
+  EXPECT_TRUE(within(f.flux2_rms_err_Wb2, d.flux2_rms_err_Wb2)) << f.flux2_rms_err_Wb2;
+  EXPECT_TRUE(within(f.load_est_rms_err_Nm, d.load_est_rms_err_Nm)) << f.load_est_rms_err_Nm;
+  EXPECT_TRUE(within(f.i_peak_total_A, d.i_peak_total_A)) << f.i_peak_total_A;
+  EXPECT_TRUE(within(f.saturated_fraction, d.saturated_fraction)) << f.saturated_fraction;
+}
+
+}  // namespace
+}  // namespace imd::sim
