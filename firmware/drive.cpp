@@ -93,8 +93,14 @@ typename Drive<T>::Estimate Drive<T>::estimate(const hal::AdcSample& sample) noe
   e.load_Nm = encoder_observer_.load_Nm();
   const hal::AdcScale scale = hw_.adc.scale();
   control::PhaseValues<T> i_abc;
+  peak_phase_current_A_ = T(0);
+  adc_saturated_ = false;
   for (int phase = 0; phase < 3; ++phase) {
     i_abc[phase] = (T(sample.phase_code[phase]) - offset_code_[phase]) * T(scale.phase_A_per_code);
+    peak_phase_current_A_ = std::max(peak_phase_current_A_, std::abs(i_abc[phase]));
+    // A code on a rail means the current is beyond what the ADC can measure.
+    adc_saturated_ = adc_saturated_ || sample.phase_code[phase] == 0 ||
+                     sample.phase_code[phase] >= scale.max_code;
   }
   const Vec2 i_alphabeta = control::clarke(i_abc);
   record_.i_alpha_A = double(i_alphabeta.x());
@@ -105,6 +111,10 @@ typename Drive<T>::Estimate Drive<T>::estimate(const hal::AdcSample& sample) noe
   if (oracle_ != nullptr) {  // ideal sensors: current, speed and position are measured exactly
     const TrueState truth = oracle_->true_state();
     e.x.i_s_AB_A = Vec2(T(truth.i_s_A_A), T(truth.i_s_B_A));
+    adc_saturated_ = false;  // the ADC is not used
+    const auto true_abc = control::inverse_clarke(Vec2(
+        control::Rotation<T>::from_angle(pole_pairs_ * T(truth.theta_mech_rad)).apply(e.x.i_s_AB_A)));
+    peak_phase_current_A_ = std::max({std::abs(true_abc[0]), std::abs(true_abc[1]), std::abs(true_abc[2])});
     e.x.omega_mech_rad_s = T(truth.omega_mech_rad_s);
     e.x.theta_mech_rad = T(truth.theta_mech_rad);
     if (config_.section_iv_load_estimator) {
@@ -127,7 +137,7 @@ template <typename T>
 control::InputDisk<T> Drive<T>::feasible_inputs(const control::RotorFrameState<T>& x,
                                                 T v_bus_V) const noexcept {
   control::InputDisk<T> voltage, current;
-  if (config_.voltage_limited && !config_.analog_inner_loop) {
+  if (config_.voltage_limited) {
     voltage = {-compensation_AB(x),
                T(config_.modulation_margin) * control::svpwm_linear_limit_V(v_bus_V)};
   }
@@ -172,12 +182,11 @@ void Drive<T>::on_tick() noexcept {
     // --- sense and estimate
     const T v_bus_V = T(sample.bus_code) * T(hw_.adc.scale().bus_V_per_code);
     const Estimate e = estimate(sample);
-    if (std::abs(record_.i_alpha_A) > config_.overcurrent_trip_A ||
-        std::abs(record_.i_beta_A) > config_.overcurrent_trip_A) {
+    if (peak_phase_current_A_ > T(config_.overcurrent_trip_A) || adc_saturated_) {
       trip(FaultCode::overcurrent);
     }
     // --- control: predict over the latency, then choose v~ for the period it will act on.
-    const bool latency = config_.pwm_latency_ticks > 0;
+    const bool latency = config_.pwm_latency_ticks > 0 && config_.compensate_latency;
     control::RotorFrameState<T> x = e.x;
     if (latency) x = model_.predict(e.x, v_in_flight_V_, e.load_Nm);
     x.theta_mech_rad = control::wrap_pi(x.theta_mech_rad);
@@ -258,7 +267,7 @@ void Drive<T>::on_tick() noexcept {
     if (state_ == DriveState::fault) v = Vec2::Zero();
 
     // --- advance the observers over the period [k, k+1] with the input acting on it.
-    const Vec2 acting = latency ? v_in_flight_V_ : v;
+    const Vec2 acting = config_.pwm_latency_ticks > 0 ? v_in_flight_V_ : v;
     flux_observer_.update(e.x.i_s_AB_A, acting);
     encoder_observer_.predict(e.x.i_s_AB_A, e.x.flux_r_AB_Wb, acting);
     load_estimator_.update(e.x.omega_mech_rad_s, e.x.i_s_AB_A, e.x.flux_r_AB_Wb, acting);

@@ -90,6 +90,8 @@ class Drive final : public hal::TickHandler {
   uint32_t last_encoder_count_ = 0;
   int64_t encoder_position_ = 0;  ///< counts within one revolution, [0, cpr)
   Vec2 v_in_flight_V_ = Vec2::Zero();  ///< written last tick, acts over this period (latency 1)
+  T peak_phase_current_A_ = T(0);      ///< largest phase current of this tick
+  bool adc_saturated_ = false;         ///< a phase-current code on a rail this tick
   TickRecord record_;
   ExecutionStats execution_;
 };

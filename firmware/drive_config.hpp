@@ -16,6 +16,9 @@ struct DriveConfig {
   /// Ticks between a duty write and its effect; the tick predicts that far with the exact
   /// model (0 or 1).
   int pwm_latency_ticks = 1;
+  /// Predict over the latency with the exact model (the default). Off only to measure what the
+  /// prediction is worth.
+  bool compensate_latency = true;
 
   // Control law.
   double max_accel_rad_s2 = std::numeric_limits<double>::infinity();  ///< speed reference ramp

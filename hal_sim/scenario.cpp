@@ -252,6 +252,7 @@ Scenario load_scenario(const std::filesystem::path& path, const std::vector<std:
   s.controller = r.choice("drive.controller", "dsmc", {"dsmc"});
   s.precision = r.choice("drive.precision", "double", {"double", "float"});
   s.max_accel_rad_s2 = r.positive("drive.max_accel_rad_s2", std::numeric_limits<double>::infinity());
+  s.compensate_latency = r.boolean("drive.compensate_latency", true);
   for (auto [key, value] : {std::pair{"drive.speed_reaching_pole", &s.speed_reaching_pole},
                             std::pair{"drive.flux_reaching_pole", &s.flux_reaching_pole}}) {
     *value = r.number(key, 0.0);
@@ -277,6 +278,7 @@ Scenario load_scenario(const std::filesystem::path& path, const std::vector<std:
     r.fail("inverter.v_bus_V", fmt::format("= {}: must be below sensors.adc_bus_full_scale_V", s.v_bus_V));
   }
   s.i_max_A = r.positive("inverter.i_max_A", std::numeric_limits<double>::infinity());
+  s.limit_voltage = r.boolean("inverter.limit_voltage", true);
 
   s.section_iv = r.boolean("observers.section_iv", false);
   s.encoder_bandwidth_rad_s = r.positive("observers.encoder_bandwidth_rad_s", 400.0);

@@ -29,6 +29,7 @@ struct Scenario {
   std::string controller = "dsmc";
   std::string precision = "double";  ///< control arithmetic: "double" or "float"
   double max_accel_rad_s2 = 0.0;     ///< speed reference ramp; inf: none
+  bool compensate_latency = true;    ///< predict over the PWM latency
   double speed_reaching_pole = 0.0;  ///< 0: the paper's deadbeat law
   double flux_reaching_pole = 0.0;
 
@@ -46,6 +47,7 @@ struct Scenario {
   // [inverter]
   double v_bus_V = 311.0;
   double i_max_A = 0.0;  ///< inf: no current limit
+  bool limit_voltage = true;  ///< false: the law ignores the bus (the paper states no limit)
 
   // [observers]
   bool section_iv = false;  ///< paper's flux observer and load estimator on the ideal speed

@@ -68,7 +68,9 @@ firmware::DriveConfig drive_config(const Scenario& s) {
   c.sample_period_s = s.sample_period_s;
   c.analog_inner_loop = s.inner_feedback == InnerFeedback::ideal_analog;
   c.pwm_latency_ticks = s.pwm_latency_ticks;
+  c.compensate_latency = s.compensate_latency;
   c.i_max_A = s.i_max_A;
+  c.voltage_limited = s.limit_voltage;
   c.max_accel_rad_s2 = s.max_accel_rad_s2;
   c.speed_reaching_pole = s.speed_reaching_pole;
   c.flux_reaching_pole = s.flux_reaching_pole;
@@ -109,6 +111,12 @@ Summary run(const Scenario& s, const RunCallbacks& callbacks) {
   for (uint64_t k = 0; k < ticks; ++k) {
     const double t_s = double(k) * s.sample_period_s;
     const PlantState truth = board.plant().state();
+    if (!truth.flux_r_alphabeta_Wb.allFinite() || !truth.i_s_alphabeta_A.allFinite() ||
+        !std::isfinite(truth.omega_mech_rad_s) || !std::isfinite(truth.theta_mech_rad)) {
+      summary.faults.push_back({"plant_diverged", t_s});  // the run ends here
+      summary.ticks = k;
+      break;
+    }
     const double load_Nm = board.load_Nm();
     const double torque_Nm = board.plant().torque_Nm();
     board.run_tick();
@@ -170,14 +178,17 @@ Summary run(const Scenario& s, const RunCallbacks& callbacks) {
       }
     }
   }
-  summary.ticks = ticks;
-  summary.simulated_s = double(ticks) * s.sample_period_s;
+  if (summary.faults.empty() || summary.faults.back().code != "plant_diverged") summary.ticks = ticks;
+  summary.simulated_s = double(summary.ticks) * s.sample_period_s;
   summary.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
-  if (measured > 0) {
-    summary.speed_rms_err_rad_s = std::sqrt(speed_sq / double(measured));
-    summary.flux2_rms_err_Wb2 = std::sqrt(flux_sq / double(measured));
-    summary.load_est_rms_err_Nm = std::sqrt(load_sq / double(measured));
-    summary.saturated_fraction = double(saturated) / double(measured);
+  // Nothing after settle_s (a run that ended early): the metrics are not defined (null in JSON).
+  const double n = measured > 0 ? double(measured) : std::nan("");
+  summary.speed_rms_err_rad_s = std::sqrt(speed_sq / n);
+  summary.flux2_rms_err_Wb2 = std::sqrt(flux_sq / n);
+  summary.load_est_rms_err_Nm = std::sqrt(load_sq / n);
+  summary.saturated_fraction = double(saturated) / n;
+  if (measured == 0) {
+    summary.speed_max_err_rad_s = summary.flux2_max_err_Wb2 = summary.i_peak_A = std::nan("");
   }
   summary.tick_exec_ns_mean = drive.execution().mean_ns();
   summary.tick_exec_ns_max = drive.execution().max_ns;

@@ -31,7 +31,8 @@ struct FaultEvent {
   double detected_at_s = 0.0;
 };
 
-/// Metrics over t > settle_s from the plant's true state (i_peak_total_A: the whole run).
+/// Metrics over t > settle_s from the plant's true state (i_peak_total_A: the whole run). NaN
+/// when the run ended before settle_s.
 struct Summary {
   double speed_rms_err_rad_s = 0.0, speed_max_err_rad_s = 0.0;
   double flux2_rms_err_Wb2 = 0.0, flux2_max_err_Wb2 = 0.0;
