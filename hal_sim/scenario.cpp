@@ -175,6 +175,15 @@ void apply_override(toml::table& doc, const std::string& assignment, const std::
   table->insert_or_assign(parts.back(), std::move(*parsed.get("value")));
 }
 
+/// A steps table: times in increasing order, one value per time.
+void read_steps(Reader& r, std::string_view times_key, std::string_view values_key,
+                std::vector<double>& times, std::vector<double>& values) {
+  times = r.numbers(times_key);
+  values = r.numbers(values_key);
+  if (times.size() != values.size()) r.fail(values_key, "must have as many entries as the times");
+  if (!std::is_sorted(times.begin(), times.end())) r.fail(times_key, "must be in increasing order");
+}
+
 void read_speed_reference(Reader& r, Scenario& s) {
   const std::string kind = r.choice("reference.speed.kind", "", {"sine", "steps"});
   if (kind.empty()) r.fail("reference.speed.kind", "missing key");
@@ -185,14 +194,8 @@ void read_speed_reference(Reader& r, Scenario& s) {
     s.speed.offset_rad_s = r.number("reference.speed.offset_rad_s", 0.0);
   } else {
     s.speed.kind = SpeedProfile::Kind::steps;
-    s.speed.times_s = r.numbers("reference.speed.times_s");
-    s.speed.values_rad_s = r.numbers("reference.speed.values_rad_s");
-    if (s.speed.times_s.size() != s.speed.values_rad_s.size()) {
-      r.fail("reference.speed.values_rad_s", "must have as many entries as times_s");
-    }
-    if (!std::is_sorted(s.speed.times_s.begin(), s.speed.times_s.end())) {
-      r.fail("reference.speed.times_s", "must be in increasing order");
-    }
+    read_steps(r, "reference.speed.times_s", "reference.speed.values_rad_s", s.speed.times_s,
+               s.speed.values_rad_s);
   }
 }
 
@@ -208,14 +211,7 @@ void read_load(Reader& r, Scenario& s) {
     s.load.period_s = r.positive("load.period_s", std::nullopt);
   } else {
     s.load.kind = LoadProfile::Kind::steps;
-    s.load.times_s = r.numbers("load.times_s");
-    s.load.values_Nm = r.numbers("load.values_Nm");
-    if (s.load.times_s.size() != s.load.values_Nm.size()) {
-      r.fail("load.values_Nm", "must have as many entries as times_s");
-    }
-    if (!std::is_sorted(s.load.times_s.begin(), s.load.times_s.end())) {
-      r.fail("load.times_s", "must be in increasing order");
-    }
+    read_steps(r, "load.times_s", "load.values_Nm", s.load.times_s, s.load.values_Nm);
   }
 }
 
