@@ -122,6 +122,8 @@ class Dsmc {
         const Interval alpha = range_on_chord(lambda1, lambda2, w_beta, in.feasible);
         out.speed_saturated = !alpha.contains(out.w_eq_alpha);
         w_alpha = alpha.clamp(out.w_eq_alpha);
+        // The final w_alpha is clamped on the chord of the final w_beta, which was solved for
+        // the pass-0 w_alpha: the flux misses by at most b1^2 |v~|^2 (~6e-8 Wb^2 at 300 V).
         if (pass == 0 && out.speed_saturated) {
           w_beta = flux_control(w_alpha, out);
         } else {

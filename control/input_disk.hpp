@@ -22,7 +22,8 @@ struct InputDisk {
   Vec2<T> center_V = Vec2<T>::Zero();
   T radius_V = std::numeric_limits<T>::infinity();  ///< infinite: no limit
 
-  bool unlimited() const noexcept { return !(radius_V < std::numeric_limits<T>::infinity()); }
+  /// Only +inf means no limit; a NaN radius (a broken input) allows nothing but the centre.
+  bool unlimited() const noexcept { return radius_V == std::numeric_limits<T>::infinity(); }
   bool contains(const Vec2<T>& v_V, T tolerance_V = T(0)) const noexcept {
     return unlimited() || (v_V - center_V).norm() <= radius_V + tolerance_V;
   }
@@ -31,7 +32,9 @@ struct InputDisk {
     if (unlimited()) return v_V;
     const Vec2<T> offset = v_V - center_V;
     const T distance = offset.norm();
-    return distance <= radius_V ? v_V : Vec2<T>(center_V + offset * (radius_V / distance));
+    if (distance <= radius_V) return v_V;
+    if (!(radius_V > T(0))) return center_V;  // zero or NaN radius
+    return center_V + offset * (radius_V / distance);
   }
 };
 

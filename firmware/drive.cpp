@@ -80,10 +80,15 @@ typename Drive<T>::Estimate Drive<T>::estimate(const hal::AdcSample& sample) noe
   // Encoder: unwrap the free-running counter by differences, keep one revolution.
   const uint32_t count = hw_.encoder.count();
   const int64_t cpr = hw_.encoder.counts_per_rev();
+  if (!encoder_started_) last_encoder_count_ = count;
   encoder_position_ += static_cast<int32_t>(count - last_encoder_count_);
   last_encoder_count_ = count;
   encoder_position_ = ((encoder_position_ % cpr) + cpr) % cpr;
   const T theta_measured_rad = T(2 * std::numbers::pi) * T(encoder_position_) / T(cpr);
+  if (!encoder_started_) {  // the first reading sets the angle; speed and load start at rest
+    encoder_observer_.reset(theta_measured_rad);
+    encoder_started_ = true;
+  }
   encoder_observer_.correct(theta_measured_rad);
 
   Estimate e;
@@ -185,6 +190,8 @@ void Drive<T>::on_tick() noexcept {
     if (peak_phase_current_A_ > T(config_.overcurrent_trip_A) || adc_saturated_) {
       trip(FaultCode::overcurrent);
     }
+    if (!(v_bus_V >= T(config_.bus_min_V))) trip(FaultCode::bus_undervoltage);  // NaN too
+    if (v_bus_V > T(config_.bus_max_V)) trip(FaultCode::bus_overvoltage);
     // --- control: predict over the latency, then choose v~ for the period it will act on.
     const bool latency = config_.pwm_latency_ticks > 0 && config_.compensate_latency;
     control::RotorFrameState<T> x = e.x;
@@ -192,7 +199,12 @@ void Drive<T>::on_tick() noexcept {
     x.theta_mech_rad = control::wrap_pi(x.theta_mech_rad);
     // References at x's step and the step after, the speed through the ramp (which follows
     // the estimate until the drive runs).
-    if (state_ != DriveState::running) speed_ramp_.reset(e.x.omega_mech_rad_s);
+    // Without a ramp limit the law sees the reference itself, so that the reaching law acts on
+    // the real error from the first running tick.
+    if (state_ != DriveState::running) {
+      speed_ramp_.reset(speed_ramp_.limited() ? e.x.omega_mech_rad_s
+                                              : T(references_.at_tick(k).omega_mech_rad_s));
+    }
     const T ramp_k1 = speed_ramp_.next(speed_ramp_.value(), T(references_.at_tick(k + 1).omega_mech_rad_s));
     Reference ref_now = references_.at_tick(k + (latency ? 1 : 0));
     Reference ref = references_.at_tick(k + (latency ? 2 : 1));
@@ -288,6 +300,12 @@ void Drive<T>::on_tick() noexcept {
   const uint64_t exec_ns = hw_.timer.execution_clock_ns() - start_ns;
   record_.exec_ns = static_cast<uint32_t>(std::min<uint64_t>(exec_ns, UINT32_MAX));
   execution_.add(record_.exec_ns);
+  if (config_.tick_budget_ns > 0 && record_.exec_ns > config_.tick_budget_ns) {
+    ++execution_.overruns;
+    trip(FaultCode::overrun);  // the PWM is off before the next period starts
+    record_.state = state_;
+    record_.fault = fault_;
+  }
 }
 
 template class Drive<float>;

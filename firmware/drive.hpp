@@ -89,6 +89,7 @@ class Drive final : public hal::TickHandler {
   T offset_code_[3] = {T(0), T(0), T(0)};
   uint32_t last_encoder_count_ = 0;
   int64_t encoder_position_ = 0;  ///< counts within one revolution, [0, cpr)
+  bool encoder_started_ = false;   ///< the first reading has set the observer's angle
   Vec2 v_in_flight_V_ = Vec2::Zero();  ///< written last tick, acts over this period (latency 1)
   T peak_phase_current_A_ = T(0);      ///< largest phase current of this tick
   bool adc_saturated_ = false;         ///< a phase-current code on a rail this tick

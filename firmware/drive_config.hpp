@@ -48,6 +48,9 @@ struct DriveConfig {
 
   // Protection (the full set comes with the drive application).
   double overcurrent_trip_A = std::numeric_limits<double>::infinity();
+  double bus_min_V = 20.0;                   ///< below: undervoltage (also a NaN reading)
+  double bus_max_V = 450.0;                  ///< above: overvoltage
+  uint32_t tick_budget_ns = 0;               ///< execution-time budget; 0: not checked (simulation)
 };
 
 }  // namespace imd::firmware

@@ -8,6 +8,7 @@ struct ExecutionStats {
   uint64_t count = 0;
   uint64_t total_ns = 0;
   uint32_t max_ns = 0;
+  uint64_t overruns = 0;  ///< ticks over the budget
 
   void add(uint32_t ns) noexcept {
     ++count;

@@ -15,6 +15,7 @@ class SpeedRamp {
       : max_step_(T(max_accel_rad_s2 * period_s)) {}
 
   T value() const noexcept { return value_; }
+  bool limited() const noexcept { return std::isfinite(max_step_); }
   void reset(T omega_rad_s) noexcept { value_ = omega_rad_s; }
   /// The ramp's value one period after `from`, heading for `target`.
   T next(T from, T target) const noexcept {

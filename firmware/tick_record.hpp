@@ -14,7 +14,26 @@ enum class FaultCode : uint8_t {
   magnetizing_timeout,
   non_finite,            ///< NaN or Inf in the duty path
   singular_control,      ///< B_k singular while running
+  bus_undervoltage,
+  bus_overvoltage,
+  overrun,               ///< the tick took longer than its budget
 };
+
+/// Stable lower-case name of a fault code, for logs and summaries.
+constexpr const char* fault_name(FaultCode code) noexcept {
+  switch (code) {
+    case FaultCode::none: return "none";
+    case FaultCode::adc_offset: return "adc_offset";
+    case FaultCode::overcurrent: return "overcurrent";
+    case FaultCode::magnetizing_timeout: return "magnetizing_timeout";
+    case FaultCode::non_finite: return "non_finite";
+    case FaultCode::singular_control: return "singular_control";
+    case FaultCode::bus_undervoltage: return "bus_undervoltage";
+    case FaultCode::bus_overvoltage: return "bus_overvoltage";
+    case FaultCode::overrun: return "overrun";
+  }
+  return "unknown";
+}
 
 struct TickRecord {
   uint64_t tick = 0;

@@ -71,15 +71,27 @@ void InductionMotorPlant::step_voltage(const Vec2& u_s_alphabeta_V, double load_
   integrate_voltage_fed([&](const StateVector&) { return u_s_alphabeta_V; }, load_Nm);
 }
 
+namespace {
+
+/// Feedback (2): u = sigma p w J (I + beta Phi) + e^{p th J} v~.
+Vec2 feedback_2(const control::Seed000Constants& k, int pole_pairs, const Vec2& flux,
+                const Vec2& current, double omega, double theta, const Vec2& v_AB_V) {
+  const double p = pole_pairs;
+  return k.sigma_H * p * omega * control::J_times<double>(current + k.beta_per_H * flux) +
+         control::Rotation<double>::from_angle(p * theta).apply(v_AB_V);
+}
+
+}  // namespace
+
+Vec2 InductionMotorPlant::analog_feedback_voltage_V(const Vec2& v_AB_V) const noexcept {
+  return feedback_2(k_, motor_.pole_pairs, state_.flux_r_alphabeta_Wb, state_.i_s_alphabeta_A,
+                    state_.omega_mech_rad_s, state_.theta_mech_rad, v_AB_V);
+}
+
 void InductionMotorPlant::step_analog_feedback(const Vec2& v_AB_V, double load_Nm) noexcept {
-  const double p = motor_.pole_pairs;
   integrate_voltage_fed(
       [&](const StateVector& x) -> Vec2 {
-        const Vec2 flux = x.segment<2>(0);
-        const Vec2 current = x.segment<2>(2);
-        const Vec2 compensation =
-            k_.sigma_H * p * x(4) * control::J_times<double>(current + k_.beta_per_H * flux);
-        return compensation + control::Rotation<double>::from_angle(p * x(5)).apply(v_AB_V);
+        return feedback_2(k_, motor_.pole_pairs, x.segment<2>(0), x.segment<2>(2), x(4), x(5), v_AB_V);
       },
       load_Nm);
 }

@@ -53,6 +53,8 @@ class InductionMotorPlant {
   /// u(t) = sigma p w J (I + beta Phi) + e^{p th(t) J} v~_k, evaluated at every RK4 stage.
   /// v~_k = e^{-p th_k J} v_k is the held rotor-frame input.
   void step_analog_feedback(const Vec2& v_AB_V, double load_Nm) noexcept;
+  /// The stator voltage (2) applies in the present state for the rotor-frame input v~.
+  Vec2 analog_feedback_voltage_V(const Vec2& v_AB_V) const noexcept;
 
   /// One period current-fed: I(t) = e^{p th(t) J} i_AB with i_AB held (paper 001's zero-order
   /// hold in the rotor frame). On return the stator current is that of the end of the period.

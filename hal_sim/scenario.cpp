@@ -43,24 +43,40 @@ class Reader {
     return doc_.at_path(path).node();
   }
 
+  /// A finite number (or the fallback, which may be infinite, when the key is absent).
   double number(std::string_view path, std::optional<double> fallback) {
     const toml::node* node = find(path);
     if (node == nullptr) {
       if (!fallback) fail(path, "missing key");
       return *fallback;
     }
-    if (const auto* real = node->as_floating_point()) return real->get();
-    if (const auto* integer = node->as_integer()) return static_cast<double>(integer->get());
-    fail(path, "must be a number");
+    double value = 0.0;
+    if (const auto* real = node->as_floating_point()) {
+      value = real->get();
+    } else if (const auto* integer = node->as_integer()) {
+      value = static_cast<double>(integer->get());
+    } else {
+      fail(path, "must be a number");
+    }
+    if (!std::isfinite(value)) fail(path, fmt::format("= {}: must be finite", value));
+    return value;
   }
   double positive(std::string_view path, std::optional<double> fallback) {
     const double value = number(path, fallback);
     if (!(value > 0.0)) fail(path, fmt::format("= {}: must be > 0", value));
     return value;
   }
+  /// A positive number, or inf for "no limit".
+  double positive_or_inf(std::string_view path) {
+    const toml::node* node = find(path);
+    if (node != nullptr && node->is_floating_point() && node->as_floating_point()->get() == std::numeric_limits<double>::infinity()) {
+      return std::numeric_limits<double>::infinity();
+    }
+    return positive(path, std::numeric_limits<double>::infinity());
+  }
   double non_negative(std::string_view path, std::optional<double> fallback) {
     const double value = number(path, fallback);
-    if (!(value >= 0.0) || std::isinf(value)) fail(path, fmt::format("= {}: must be finite and >= 0", value));
+    if (!(value >= 0.0)) fail(path, fmt::format("= {}: must be >= 0", value));
     return value;
   }
   int64_t integer(std::string_view path, int64_t fallback, int64_t low, int64_t high) {
@@ -244,10 +260,12 @@ Scenario load_scenario(const std::filesystem::path& path, const std::vector<std:
   r.accept_table("motor");
 
   s.sample_period_s = r.positive("drive.sample_period_s", 1e-4);
-  if (s.sample_period_s > 1e-2) r.fail("drive.sample_period_s", fmt::format("= {}: must be <= 0.01", s.sample_period_s));
+  if (s.sample_period_s < 1e-6 || s.sample_period_s > 1e-2) {
+    r.fail("drive.sample_period_s", fmt::format("= {}: must be in [1e-6, 1e-2] s", s.sample_period_s));
+  }
   s.controller = r.choice("drive.controller", "dsmc", {"dsmc"});
   s.precision = r.choice("drive.precision", "double", {"double", "float"});
-  s.max_accel_rad_s2 = r.positive("drive.max_accel_rad_s2", std::numeric_limits<double>::infinity());
+  s.max_accel_rad_s2 = r.positive_or_inf("drive.max_accel_rad_s2");
   s.compensate_latency = r.boolean("drive.compensate_latency", true);
   for (auto [key, value] : {std::pair{"drive.speed_reaching_pole", &s.speed_reaching_pole},
                             std::pair{"drive.flux_reaching_pole", &s.flux_reaching_pole}}) {
@@ -257,6 +275,9 @@ Scenario load_scenario(const std::filesystem::path& path, const std::vector<std:
 
   read_speed_reference(r, s);
   s.flux2_Wb2 = r.positive("reference.flux.flux2_Wb2", std::nullopt);
+  if (s.flux2_Wb2 <= 2e-3) {  // the drive refuses B_k below 1e-3 Wb^2 (DriveConfig)
+    r.fail("reference.flux.flux2_Wb2", fmt::format("= {}: must be > 0.002 Wb^2", s.flux2_Wb2));
+  }
   read_load(r, s);
 
   s.ideal_sensors = r.boolean("sensors.ideal", false);
@@ -273,10 +294,13 @@ Scenario load_scenario(const std::filesystem::path& path, const std::vector<std:
   if (s.v_bus_V >= s.adc.bus_full_scale_V) {
     r.fail("inverter.v_bus_V", fmt::format("= {}: must be below sensors.adc_bus_full_scale_V", s.v_bus_V));
   }
-  s.i_max_A = r.positive("inverter.i_max_A", std::numeric_limits<double>::infinity());
+  s.i_max_A = r.positive_or_inf("inverter.i_max_A");
   s.limit_voltage = r.boolean("inverter.limit_voltage", true);
 
   s.section_iv = r.boolean("observers.section_iv", false);
+  if (s.section_iv && !s.ideal_sensors) {
+    r.fail("observers.section_iv", "needs sensors.ideal = true (the Section IV estimators take the measured speed)");
+  }
   s.encoder_bandwidth_rad_s = r.positive("observers.encoder_bandwidth_rad_s", 400.0);
   s.load_estimator_pole = r.number("observers.load_estimator_pole", 0.99);
   if (!(s.load_estimator_pole > 0.0 && s.load_estimator_pole < 1.0)) {
@@ -284,6 +308,7 @@ Scenario load_scenario(const std::filesystem::path& path, const std::vector<std:
   }
 
   s.duration_s = r.positive("simulation.duration_s", 1.0);
+  if (s.duration_s > 3600.0) r.fail("simulation.duration_s", fmt::format("= {}: must be <= 3600 s", s.duration_s));
   s.substeps = static_cast<int>(r.integer("simulation.substeps", 10, 1, 10000));
   s.inner_feedback = r.choice("simulation.inner_feedback", "digital", {"digital", "ideal_analog"}) == "digital"
                          ? InnerFeedback::digital
@@ -291,6 +316,7 @@ Scenario load_scenario(const std::filesystem::path& path, const std::vector<std:
   s.pwm_latency_ticks = static_cast<int>(r.integer("simulation.pwm_latency_ticks", 1, 0, 1));
   s.seed = static_cast<uint64_t>(r.integer("simulation.seed", 1, 0, std::numeric_limits<int64_t>::max()));
   s.initial_flux2_Wb2 = r.non_negative("simulation.initial_flux2_Wb2", 0.0);
+  s.initial_theta_mech_rad = r.number("simulation.initial_theta_mech_rad", 0.0);
 
   s.settle_s = r.non_negative("metrics.settle_s", 0.5);
   if (s.settle_s >= s.duration_s) {

@@ -61,6 +61,7 @@ struct Scenario {
   int pwm_latency_ticks = 1;
   uint64_t seed = 1;
   double initial_flux2_Wb2 = 0.0;  ///< start magnetized at rest with this squared flux
+  double initial_theta_mech_rad = 0.0;  ///< rotor position at the start
 
   // [metrics]
   double settle_s = 0.5;

@@ -36,10 +36,7 @@ void SimBoard::run_tick() {
     applied_voltage_V_.setZero();
     plant_.step_current_fed(Vec2::Zero(), load_now_Nm);
   } else if (config_.inner_feedback == InnerFeedback::ideal_analog) {
-    const PlantState& s = plant_.state();
-    const double p = plant_.pole_pairs();
-    applied_voltage_V_ =
-        control::Rotation<double>::from_angle(p * s.theta_mech_rad).apply(active_analog_input_V_);
+    applied_voltage_V_ = plant_.analog_feedback_voltage_V(active_analog_input_V_);
     plant_.step_analog_feedback(active_analog_input_V_, load_now_Nm);
   } else {
     applied_voltage_V_ = inverter_output_V(active_duty_, config_.v_bus_V);

@@ -70,13 +70,40 @@ TEST(Seed000Realistic, MeetsTheTrackingAndLimitTargets) {
                                      {}});
   EXPECT_TRUE(r.faults.empty());
   EXPECT_TRUE(all_finite);  // nothing non-finite ever reached the inverter
+  // The acceptance bounds.
   EXPECT_LE(r.speed_rms_err_rad_s, 0.5);
   EXPECT_LE(r.flux2_rms_err_Wb2, 0.02 * s.flux2_Wb2);
   EXPECT_LE(r.i_peak_total_A, s.i_max_A);  // the whole run, start-up included
-  EXPECT_GE(r.saturated_fraction, 0.0);
-  EXPECT_LE(r.saturated_fraction, 1.0);
+  // What the design achieves, with room for the noise: over ADC seeds 1-4 the speed RMS is
+  // 0.067-0.079 rad/s, the flux^2 RMS 1.28-1.52e-4 Wb^2 and the saturated fraction 0.29-0.30;
+  // 1.5 times the worst seed bounds them. A reaching law of the wrong sign saturates 99 % of
+  // the ticks, the paper's deadbeat law 97.5 %.
+  EXPECT_LE(r.speed_rms_err_rad_s, 1.5 * 0.079);
+  EXPECT_LE(r.flux2_rms_err_Wb2, 1.5 * 1.52e-4);
+  EXPECT_LE(r.saturated_fraction, 1.5 * 0.30);
   std::printf("realistic: speed rms %.4f rad/s, flux2 rms %.3e Wb^2, i peak %.3f A, saturated %.3f\n",
               r.speed_rms_err_rad_s, r.flux2_rms_err_Wb2, r.i_peak_total_A, r.saturated_fraction);
+}
+
+TEST(Seed000Realistic, StartsFromAnyRotorAngle) {
+  // The encoder observer takes its first angle from the encoder; a rotor at rest at 3.1 rad
+  // must give the same performance as at 0 (0.087 against 0.079 rad/s RMS measured).
+  const Summary r = run_scenario(scenario("seed000_realistic.toml", {"simulation.initial_theta_mech_rad=3.1"}));
+  EXPECT_TRUE(r.faults.empty());
+  EXPECT_LE(r.speed_rms_err_rad_s, 1.5 * 0.079);
+  EXPECT_LE(r.i_peak_total_A, 6.0);
+}
+
+TEST(Seed000Paper, DigitalInnerFeedbackStaysCloseToTheAnalogLaw) {
+  // Ideal sensors, no latency, a 3000 V bus so that nothing clips: what is left is running (2)
+  // sampled and held. The held voltage is rotated to the middle of its period; measured
+  // flux^2 RMS 1.0e-7 Wb^2 with it, 3.6e-7 without, speed RMS 8.5e-6 rad/s (analog: 2e-11).
+  const Summary r = run_scenario(scenario(
+      "seed000_paper.toml", {"inverter.v_bus_V=3000", "sensors.adc_bus_full_scale_V=4000",
+                             "simulation.inner_feedback=digital"}));
+  EXPECT_TRUE(r.faults.empty());
+  EXPECT_LE(r.flux2_rms_err_Wb2, 2e-7);
+  EXPECT_LE(r.speed_rms_err_rad_s, 2e-5);
 }
 
 TEST(Seed000Realistic, FloatControlStaysCloseToDouble) {

@@ -91,5 +91,42 @@ TEST(DriveTick, OvercurrentTurnsThePwmOffInTheSameTick) {
   EXPECT_EQ(drive.fault(), FaultCode::overcurrent);
 }
 
+/// A drive on the board, wired, with the given configuration.
+struct Rig {
+  sim::SimBoard board;
+  Constant references;
+  Drive<double> drive;
+  Rig(const sim::SimBoardConfig& board_config, const DriveConfig& config)
+      : board(test::test_motors()[0].parameters, board_config),
+        drive(test::test_motors()[0].parameters, config,
+              {board.pwm(), board.encoder(), board.adc(), board.timer()}, references) {
+    board.timer().start(drive);
+  }
+};
+
+TEST(DriveTick, BusUnderAndOvervoltageTrip) {
+  for (const double bus_V : {150.0, 480.0}) {
+    sim::SimBoardConfig board_config;
+    board_config.v_bus_V = bus_V;
+    DriveConfig config;
+    config.bus_min_V = 200.0;
+    config.bus_max_V = 450.0;
+    Rig rig(board_config, config);
+    for (int k = 0; k < 300; ++k) rig.board.run_tick();  // past the offset calibration
+    EXPECT_EQ(rig.drive.fault(), bus_V < 200.0 ? FaultCode::bus_undervoltage : FaultCode::bus_overvoltage);
+    EXPECT_FALSE(rig.board.pwm().enabled());
+  }
+}
+
+TEST(DriveTick, OverrunTrips) {
+  DriveConfig config;
+  config.tick_budget_ns = 1;  // no tick runs in 1 ns
+  Rig rig({}, config);
+  for (int k = 0; k < 300; ++k) rig.board.run_tick();
+  EXPECT_EQ(rig.drive.fault(), FaultCode::overrun);
+  EXPECT_FALSE(rig.board.pwm().enabled());
+  EXPECT_GE(rig.drive.execution().overruns, 1u);
+}
+
 }  // namespace
 }  // namespace imd::firmware

@@ -113,6 +113,64 @@ TEST_F(DsmcTest, SaturatedFluxChannelMovesTowardsTheReference) {
   EXPECT_NEAR(next.flux_r_AB_Wb.squaredNorm(), best, 1e-6 * best);
 }
 
+TEST_F(DsmcTest, OffCentreDiskBoundsTheInputExactly) {
+  // The voltage disk of a running motor is centred at -sigma p w J (I~ + beta Phi~), not at 0.
+  // A saturated input must lie on that disk's boundary, not merely near the origin.
+  const auto x = running();
+  for (const Vec2<double>& centre : {Vec2<double>(-40.0, 25.0), Vec2<double>(60.0, -80.0)}) {
+    auto in = input_for(x, 80.0, 0.2, 0.0);  // saturates the speed channel
+    in.feasible = {centre, 120.0};
+    const auto out = dsmc.step(in);
+    ASSERT_EQ(out.status, DsmcStatus::ok);
+    ASSERT_TRUE(out.speed_saturated);
+    EXPECT_NEAR((out.v_AB_V - centre).norm(), 120.0, 1e-6) << centre.transpose();
+    // And the speed gained is the most the disk allows along lambda1 for this flux control:
+    // no input of the chord gives more (checked on a fine sweep of the boundary).
+    const double gained = model.predict(x, out.v_AB_V, 0.0).omega_mech_rad_s;
+    const double flux_next = model.predict(x, out.v_AB_V, 0.0).flux_r_AB_Wb.squaredNorm();
+    for (int i = 0; i < 3600; ++i) {
+      const double a = i * 2 * 3.141592653589793 / 3600;
+      const Vec2<double> v = centre + 120.0 * Vec2<double>(std::cos(a), std::sin(a));
+      const auto next = model.predict(x, v, 0.0);
+      if (std::abs(next.flux_r_AB_Wb.squaredNorm() - flux_next) < 1e-7) {
+        EXPECT_LE(next.omega_mech_rad_s, gained + 1e-6);
+      }
+    }
+  }
+}
+
+TEST_F(DsmcTest, OffCentreDiskBoundsTheFluxChannel) {
+  // A flux step the disk cannot deliver: the flux channel takes the disk's point that raises
+  // |Phi_{k+1}|^2 most, c + r m/|m| with m = a11 Phi + a12 I (the flux without input).
+  const auto x = running();
+  const Vec2<double> m = coefficients.a11 * x.flux_r_AB_Wb + coefficients.a12 * x.i_s_AB_A;
+  for (const Vec2<double>& centre : {Vec2<double>(-40.0, 25.0), Vec2<double>(60.0, -80.0)}) {
+    auto in = input_for(x, 50.0, 0.8, 0.0);
+    in.feasible = {centre, 120.0};
+    const auto out = dsmc.step(in);
+    ASSERT_EQ(out.status, DsmcStatus::ok);
+    ASSERT_TRUE(out.flux_saturated);
+    EXPECT_NEAR((out.v_AB_V - centre).norm(), 120.0, 1e-6);
+    const Vec2<double> best_v = centre + 120.0 * m.normalized();
+    const double best = model.predict(x, best_v, 0.0).flux_r_AB_Wb.squaredNorm();
+    EXPECT_NEAR(model.predict(x, out.v_AB_V, 0.0).flux_r_AB_Wb.squaredNorm(), best, 1e-6 * best);
+  }
+}
+
+TEST_F(DsmcTest, ReachingLawsScaleTheErrors) {
+  // e_{k+1} = pole e_k for both outputs, on the exact model, with no limit.
+  const Dsmc<double> law(coefficients, DsmcConfig{1e-3, 0.9, 0.8});
+  auto x = running();
+  auto in = input_for(x, 52.0, 0.21, 0.3);
+  in.omega_ref_rad_s = 52.0;  // speed error at k: 50 - 52 = -2
+  in.flux2_ref_Wb2 = 0.21;    // flux error at k: 0.2 - 0.21 = -0.01
+  const auto out = law.step(in);
+  ASSERT_EQ(out.status, DsmcStatus::ok);
+  const auto next = model.predict(x, out.v_AB_V, 0.3);
+  EXPECT_NEAR(next.omega_mech_rad_s - 52.0, 0.9 * -2.0, 1e-9);
+  EXPECT_NEAR(next.flux_r_AB_Wb.squaredNorm() - 0.21, 0.8 * -0.01, 1e-10);
+}
+
 TEST_F(DsmcTest, SingularBkIsRefusedAtZeroFlux) {
   RotorFrameState<double> x;  // unmagnetized: B_k = 0
   for (const double current_A : {0.0, 3.0}) {

@@ -69,6 +69,13 @@ TEST(Scenario, BadInputNamesTheKey) {
       {{"inverter.v_bus_V=600"}, "inverter.v_bus_V: = 600: must be below sensors.adc_bus_full_scale_V"},
       {{"duration_s"}, "--set duration_s: expected table.key=VALUE"},
       {{"=3"}, "--set =3: expected table.key=VALUE"},
+      {{"simulation.duration_s=inf"}, "simulation.duration_s: = inf: must be finite"},
+      {{"load.high_Nm=nan"}, "load.high_Nm: = nan: must be finite"},
+      {{"sensors.adc_bus_full_scale_V=inf"}, "sensors.adc_bus_full_scale_V: = inf: must be finite"},
+      {{"drive.sample_period_s=1e-9"}, "drive.sample_period_s: = 1e-09: must be in [1e-6, 1e-2] s"},
+      {{"reference.flux.flux2_Wb2=5e-4"}, "reference.flux.flux2_Wb2: = 0.0005: must be > 0.002 Wb^2"},
+      {{"sensors.ideal=false", "observers.section_iv=true"}, "observers.section_iv: needs sensors.ideal = true"},
+      {{"inverter.i_max_A=-inf"}, "inverter.i_max_A: = -inf: must be finite"},
   };
   for (const Case& c : cases) {
     const std::string message = error_of(kPaper, c.overrides);

@@ -77,5 +77,13 @@ TEST(InputDisk, NestedDisjointAndUnlimitedCases) {
   EXPECT_EQ(big.clamp({200.0, 0.0}), Vec2<double>(100.0, 0.0));
 }
 
+TEST(InputDisk, NanRadiusAllowsOnlyTheCentre) {
+  // A NaN limit (a broken bus reading) must not read as "no limit".
+  const InputDisk<double> broken{{5.0, 1.0}, std::nan("")};
+  EXPECT_FALSE(broken.unlimited());
+  EXPECT_EQ(broken.clamp({300.0, 0.0}), Vec2<double>(5.0, 1.0));
+  EXPECT_FALSE(broken.contains({300.0, 0.0}));
+}
+
 }  // namespace
 }  // namespace imd::control

@@ -7,7 +7,6 @@
 // line or scenario file), 1 an output could not be written.
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
-#include <fmt/os.h>
 #include <nlohmann/json.hpp>
 
 #include <cmath>
@@ -16,10 +15,15 @@
 #include <filesystem>
 #include <iostream>
 #include <optional>
+#include <system_error>
 #include <string>
 #include <vector>
 
+#include <spawn.h>
+#include <sys/wait.h>
 #include <unistd.h>
+
+extern char** environ;
 
 #include "hal_sim/config_error.hpp"
 #include "hal_sim/scenario.hpp"
@@ -65,6 +69,18 @@ std::string plot_script() {
   return (std::filesystem::path(IMD_SOURCE_DIR) / "tools" / "plot_seed000.py").string();
 }
 
+/// Runs a program with these arguments (no shell, so no quoting) and returns its exit status.
+int run_program(std::vector<std::string> args) {
+  std::vector<char*> argv;
+  for (std::string& arg : args) argv.push_back(arg.data());
+  argv.push_back(nullptr);
+  pid_t pid = 0;
+  if (posix_spawn(&pid, argv[0], nullptr, nullptr, argv.data(), environ) != 0) return -1;
+  int status = 0;
+  if (waitpid(pid, &status, 0) < 0 || !WIFEXITED(status)) return -1;
+  return WEXITSTATUS(status);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -98,21 +114,21 @@ int main(int argc, char** argv) {
   // The plot is drawn from the CSV; without --csv a temporary file serves.
   const bool temporary_csv = csv_path.empty() && !plot_path.empty();
   if (temporary_csv) csv_path = (std::filesystem::temp_directory_path() / fmt::format("drive_sim_{}.csv", ::getpid())).string();
-  std::optional<fmt::ostream> csv;
-  try {
-    if (!csv_path.empty()) {
-      csv.emplace(fmt::output_file(csv_path));
-      csv->print("{}", kCsvHeader);
+  std::FILE* csv = nullptr;
+  if (!csv_path.empty()) {
+    csv = std::fopen(csv_path.c_str(), "w");
+    if (csv == nullptr) {
+      std::cerr << "drive_sim: cannot write " << csv_path << '\n';
+      return kExitOutputFailed;
     }
-  } catch (const std::system_error& error) {
-    std::cerr << "drive_sim: cannot write " << csv_path << ": " << error.what() << '\n';
-    return kExitOutputFailed;
+    std::fputs(kCsvHeader, csv);
   }
 
   imd::sim::RunCallbacks callbacks;
-  if (csv) {
+  if (csv != nullptr) {
     callbacks.row = [&](const imd::sim::SimRow& r) {
-      csv->print("{:.6f},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.6g},{:.6g},{:.6g},{:.6g},"
+      fmt::print(csv,
+                 "{:.6f},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.6g},{:.6g},{:.6g},{:.6g},"
                  "{:.6g},{:.6g},{:.8g},{:.8g},{:.8g},{:.8g},{:.8g},{:.8g},{:.8g},{:.8g},{:.6g},{},{}\n",
                  r.t_s, r.omega_mech_rad_s, r.omega_ref_rad_s, r.omega_est_rad_s, r.flux2_Wb2,
                  r.flux2_ref_Wb2, r.flux2_est_Wb2, r.load_Nm, r.load_est_Nm, r.i_alpha_A, r.i_beta_A,
@@ -125,9 +141,19 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "\rdrive_sim: %.2f / %.2f s simulated, %.1f s wall", simulated_s,
                  scenario.duration_s, wall_s);
   };
-  const imd::sim::Summary summary = imd::sim::run_scenario(scenario, callbacks);
+  imd::sim::Summary summary;
+  bool written = true;
+  try {
+    summary = imd::sim::run_scenario(scenario, callbacks);
+  } catch (const std::system_error&) {  // fmt reports a failed CSV write (disk full) this way
+    written = false;
+  }
+  if (csv != nullptr) written = std::ferror(csv) == 0 && std::fclose(csv) == 0 && written;
+  if (!written) {
+    std::cerr << "\ndrive_sim: cannot write " << csv_path << " (disk full?)\n";
+    return kExitOutputFailed;
+  }
   if (summary.wall_time_s > 1.0) std::fprintf(stderr, "\n");
-  if (csv) csv->close();
 
   const std::string text = summary_json(scenario, summary).dump(2);
   std::cout << text << '\n';
@@ -139,12 +165,12 @@ int main(int argc, char** argv) {
     }
   }
   if (!plot_path.empty()) {
-    const std::string command = fmt::format("/usr/bin/python3 '{}' '{}' --out '{}' --settle-s {}",
-                                            plot_script(), csv_path, plot_path, scenario.settle_s);
-    const int status = std::system(command.c_str());
+    const int status = run_program({"/usr/bin/python3", plot_script(), csv_path, "--out", plot_path,
+                                    "--settle-s", fmt::format("{}", scenario.settle_s)});
     if (temporary_csv) std::filesystem::remove(csv_path);
     if (status != 0) {
-      std::cerr << "drive_sim: plotting failed (" << command << ")\n";
+      std::cerr << "drive_sim: plotting failed (tools/plot_seed000.py, status " << status
+                << "; it needs python3-matplotlib)\n";
       return kExitOutputFailed;
     }
   }

@@ -38,18 +38,6 @@ class PlantOracle final : public firmware::StateOracle {
   const SimBoard& board_;
 };
 
-const char* fault_name(firmware::FaultCode code) {
-  switch (code) {
-    case firmware::FaultCode::none: return "none";
-    case firmware::FaultCode::adc_offset: return "adc_offset";
-    case firmware::FaultCode::overcurrent: return "overcurrent";
-    case firmware::FaultCode::magnetizing_timeout: return "magnetizing_timeout";
-    case firmware::FaultCode::non_finite: return "non_finite";
-    case firmware::FaultCode::singular_control: return "singular_control";
-  }
-  return "unknown";
-}
-
 SimBoardConfig board_config(const Scenario& s) {
   SimBoardConfig c;
   c.period_s = s.sample_period_s;
@@ -75,6 +63,8 @@ firmware::DriveConfig drive_config(const Scenario& s) {
   c.speed_reaching_pole = s.speed_reaching_pole;
   c.flux_reaching_pole = s.flux_reaching_pole;
   c.overcurrent_trip_A = 1.5 * s.i_max_A;
+  c.bus_min_V = 0.7 * s.v_bus_V;  // +-30 % of the nominal bus
+  c.bus_max_V = 1.3 * s.v_bus_V;
   c.adc_calibration_ticks = s.ideal_sensors ? 0 : 256;
   c.section_iv_load_estimator = s.section_iv;
   c.encoder_observer_bandwidth_rad_s = s.encoder_bandwidth_rad_s;
@@ -86,10 +76,12 @@ template <typename T>
 Summary run(const Scenario& s, const RunCallbacks& callbacks) {
   SimBoard board(s.motor, board_config(s));
   board.set_load_profile(s.load);
-  if (s.initial_flux2_Wb2 > 0.0) {  // magnetized steady state at rest: Phi = Lm I, along A
+  {  // at rest at initial_theta; magnetized (Phi = Lm I, along A) if initial_flux2 > 0
     PlantState start;
-    start.flux_r_alphabeta_Wb = {std::sqrt(s.initial_flux2_Wb2), 0.0};
-    start.i_s_alphabeta_A = {std::sqrt(s.initial_flux2_Wb2) / s.motor.Lm_H, 0.0};
+    start.theta_mech_rad = s.initial_theta_mech_rad;
+    const auto rotor = control::Rotation<double>::from_angle(s.motor.pole_pairs * s.initial_theta_mech_rad);
+    start.flux_r_alphabeta_Wb = rotor.apply(Vec2(std::sqrt(s.initial_flux2_Wb2), 0.0));
+    start.i_s_alphabeta_A = rotor.apply(Vec2(std::sqrt(s.initial_flux2_Wb2) / s.motor.Lm_H, 0.0));
     board.plant().set_state(start);
   }
   const ScenarioReferences references(s);
@@ -154,7 +146,7 @@ Summary run(const Scenario& s, const RunCallbacks& callbacks) {
     summary.i_peak_total_A = std::max(summary.i_peak_total_A, current_A);
     if (summary.running_from_s < 0 && rec.state == firmware::DriveState::running) summary.running_from_s = t_s;
     if (rec.fault != last_fault) {
-      summary.faults.push_back({fault_name(rec.fault), t_s});
+      summary.faults.push_back({firmware::fault_name(rec.fault), t_s});
       last_fault = rec.fault;
     }
     if (t_s > s.settle_s) {
