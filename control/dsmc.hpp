@@ -67,10 +67,17 @@ template <typename T>
 class Dsmc {
  public:
   Dsmc(const ExactModel000Coefficients& c, const DsmcConfig& config) noexcept
-      : a11_(T(c.a11)), a12_(T(c.a12)), b1_(T(c.b1)), eta1_(T(c.eta1)), eta2_(T(c.eta2)),
-        eta3_(T(c.eta3)), omega_decay_(T(c.omega_decay)), load_to_omega_(T(c.load_to_omega)),
+      : a11_(T(c.a11)),
+        a12_(T(c.a12)),
+        b1_(T(c.b1)),
+        eta1_(T(c.eta1)),
+        eta2_(T(c.eta2)),
+        eta3_(T(c.eta3)),
+        omega_decay_(T(c.omega_decay)),
+        load_to_omega_(T(c.load_to_omega)),
         min_det_(T(std::abs(2.0 * c.b1 * c.eta2 * c.a11) * config.min_flux2_Wb2)),
-        speed_pole_(T(config.speed_reaching_pole)), flux_pole_(T(config.flux_reaching_pole)) {}
+        speed_pole_(T(config.speed_reaching_pole)),
+        flux_pole_(T(config.flux_reaching_pole)) {}
 
   /// One step of the law. Tick context.
   DsmcOutput<T> step(const DsmcInput<T>& in) const noexcept {
@@ -91,8 +98,10 @@ class Dsmc {
     out.status = DsmcStatus::ok;
 
     // Targets of the next step: the reference plus what the reaching law leaves of the error.
-    const T omega_target = in.omega_ref_next_rad_s + speed_pole_ * (in.omega_mech_rad_s - in.omega_ref_rad_s);
-    const T flux2_target = in.flux2_ref_next_Wb2 + flux_pole_ * (flux.squaredNorm() - in.flux2_ref_Wb2);
+    const T omega_target =
+        in.omega_ref_next_rad_s + speed_pole_ * (in.omega_mech_rad_s - in.omega_ref_rad_s);
+    const T flux2_target =
+        in.flux2_ref_next_Wb2 + flux_pole_ * (flux.squaredNorm() - in.flux2_ref_Wb2);
     out.w_eq_alpha = omega_target - xi1 - load_to_omega_ * in.load_Nm;
     const T lambda11 = lambda1.squaredNorm(), lambda22 = lambda2.squaredNorm();
     const T lambda12 = lambda1.dot(lambda2);

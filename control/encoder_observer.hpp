@@ -44,8 +44,7 @@ inline Eigen::Vector3d place_encoder_observer(const ExactModel000Coefficients& c
 inline Eigen::Matrix3d encoder_observer_error_matrix(const ExactModel000Coefficients& c,
                                                      const Eigen::Vector3d& gain) {
   Eigen::Matrix3d a;
-  a << 1.0, c.omega_to_theta_s, c.load_to_theta, 0.0, c.omega_decay, c.load_to_omega, 0.0, 0.0,
-      1.0;
+  a << 1.0, c.omega_to_theta_s, c.load_to_theta, 0.0, c.omega_decay, c.load_to_omega, 0.0, 0.0, 1.0;
   return a - gain * (Eigen::RowVector3d(1.0, 0.0, 0.0) * a);
 }
 
@@ -61,10 +60,15 @@ template <typename T>
 class EncoderObserver {
  public:
   EncoderObserver(const ExactModel000Coefficients& c, const EncoderObserverConfig& config)
-      : omega_to_theta_(T(c.omega_to_theta_s)), load_to_theta_(T(c.load_to_theta)),
-        omega_decay_minus_one_(T(c.omega_decay_minus_one)), load_to_omega_(T(c.load_to_omega)),
+      : omega_to_theta_(T(c.omega_to_theta_s)),
+        load_to_theta_(T(c.load_to_theta)),
+        omega_decay_minus_one_(T(c.omega_decay_minus_one)),
+        load_to_omega_(T(c.load_to_omega)),
         eta1_(T(c.eta1)),
-        eta2_(T(c.eta2)), eta3_(T(c.eta3)), kappa1_(T(c.kappa1)), kappa2_(T(c.kappa2)),
+        eta2_(T(c.eta2)),
+        eta3_(T(c.eta3)),
+        kappa1_(T(c.kappa1)),
+        kappa2_(T(c.kappa2)),
         kappa3_(T(c.kappa3)) {
     const Eigen::Vector3d l = place_encoder_observer(c, config.bandwidth_rad_s);
     gain_theta_ = T(l(0));
@@ -84,7 +88,8 @@ class EncoderObserver {
 
   /// Predicts step k+1 from step k, with I~_k, the flux estimate and the v~_k that acts over
   /// the period. Tick context (end of tick k).
-  void predict(const Vec2<T>& i_s_AB_A, const Vec2<T>& flux_r_AB_Wb, const Vec2<T>& v_AB_V) noexcept {
+  void predict(const Vec2<T>& i_s_AB_A, const Vec2<T>& flux_r_AB_Wb,
+               const Vec2<T>& v_AB_V) noexcept {
     const T q = dot_J(i_s_AB_A, flux_r_AB_Wb);
     const T flux_input = dot_J(flux_r_AB_Wb, v_AB_V);
     const T current_input = dot_J(i_s_AB_A, v_AB_V);
@@ -113,7 +118,9 @@ class EncoderObserver {
   }
 
  private:
-  static T wrap_2pi(T angle_rad) noexcept { return wrap_pi(angle_rad - T(std::numbers::pi)) + T(std::numbers::pi); }
+  static T wrap_2pi(T angle_rad) noexcept {
+    return wrap_pi(angle_rad - T(std::numbers::pi)) + T(std::numbers::pi);
+  }
 
   T omega_to_theta_, load_to_theta_, omega_decay_minus_one_, load_to_omega_;
   T eta1_, eta2_, eta3_, kappa1_, kappa2_, kappa3_;

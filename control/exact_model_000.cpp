@@ -9,7 +9,7 @@ namespace imd::control {
 Eigen::Matrix3d seed000_axis_generator(const MotorParameters& motor) {
   const Seed000Constants k = derive_seed000(motor);
   Eigen::Matrix3d a;
-  a << -k.alpha_per_s, k.alpha_per_s * motor.Lm_H, 0.0,              //
+  a << -k.alpha_per_s, k.alpha_per_s * motor.Lm_H, 0.0,               //
       k.alpha_per_s * k.beta_per_H, -k.gamma_per_s, 1.0 / k.sigma_H,  //
       0.0, 0.0, 0.0;
   return a;

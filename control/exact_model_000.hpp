@@ -27,11 +27,11 @@ struct ExactModel000Coefficients {
   double kappa1 = 0.0, kappa2 = 0.0, kappa3 = 0.0;
   // Mechanical coefficients: exp(-c delta/J) and its integrals; 1, delta, -delta/J and
   // -delta^2/(2J) without friction.
-  double omega_decay = 1.0;      ///< coefficient of w_k in w_{k+1}
+  double omega_decay = 1.0;            ///< coefficient of w_k in w_{k+1}
   double omega_decay_minus_one = 0.0;  ///< omega_decay - 1 without cancellation (expm1)
-  double omega_to_theta_s = 0.0;  ///< coefficient of w_k in th_{k+1}
-  double load_to_omega = 0.0;     ///< coefficient of C_L in w_{k+1}, rad/s per N m
-  double load_to_theta = 0.0;     ///< coefficient of C_L in th_{k+1}, rad per N m
+  double omega_to_theta_s = 0.0;       ///< coefficient of w_k in th_{k+1}
+  double load_to_omega = 0.0;          ///< coefficient of C_L in w_{k+1}, rad/s per N m
+  double load_to_theta = 0.0;          ///< coefficient of C_L in th_{k+1}, rad per N m
 };
 
 /// Computes the coefficients numerically exactly from matrix exponentials (Eigen's
@@ -70,11 +70,21 @@ template <typename T>
 class ExactModel000 {
  public:
   explicit ExactModel000(const ExactModel000Coefficients& c) noexcept
-      : a11_(T(c.a11)), a12_(T(c.a12)), a21_(T(c.a21)), a22_(T(c.a22)), b1_(T(c.b1)),
-        b2_(T(c.b2)), eta1_(T(c.eta1)), eta2_(T(c.eta2)), eta3_(T(c.eta3)),
-        kappa1_(T(c.kappa1)), kappa2_(T(c.kappa2)), kappa3_(T(c.kappa3)),
+      : a11_(T(c.a11)),
+        a12_(T(c.a12)),
+        a21_(T(c.a21)),
+        a22_(T(c.a22)),
+        b1_(T(c.b1)),
+        b2_(T(c.b2)),
+        eta1_(T(c.eta1)),
+        eta2_(T(c.eta2)),
+        eta3_(T(c.eta3)),
+        kappa1_(T(c.kappa1)),
+        kappa2_(T(c.kappa2)),
+        kappa3_(T(c.kappa3)),
         omega_decay_minus_one_(T(c.omega_decay_minus_one)),
-        omega_to_theta_s_(T(c.omega_to_theta_s)), load_to_omega_(T(c.load_to_omega)),
+        omega_to_theta_s_(T(c.omega_to_theta_s)),
+        load_to_omega_(T(c.load_to_omega)),
         load_to_theta_(T(c.load_to_theta)) {}
 
   /// State at step k+1 from the state at step k, the rotor-frame input v~_k (the voltage v of

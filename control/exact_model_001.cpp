@@ -4,7 +4,9 @@
 
 namespace imd::control {
 
-double phi1(double x) noexcept { return x == 0.0 ? 1.0 : std::expm1(x) / x; }
+double phi1(double x) noexcept {
+  return x == 0.0 ? 1.0 : std::expm1(x) / x;
+}
 
 ExactModel001Coefficients discretize_seed001(const MotorParameters& motor, double T0_s) {
   const Seed001Constants k = derive_seed001(motor);

@@ -17,16 +17,16 @@ namespace imd::control {
 
 /// Constant coefficients of the exact discrete model for one motor and period T0.
 struct ExactModel001Coefficients {
-  double T0_s = 0.0;                 ///< control period
-  double flux_decay = 0.0;           ///< e^{-eta T0}
-  double flux_from_i_now_H = 0.0;    ///< ls (1 - sigma - e^{-eta T0}), multiplies i_k
-  double flux_from_i_next_H = 0.0;   ///< ls sigma, multiplies i_{k+1}
-  double torque_per_flux_A = 0.0;    ///< k_T n_p: tau = k_T n_p i^T J phi, N m per Wb A
-  double eta_per_s = 0.0;            ///< decay rate of the torque inside a period
-  double speed_decay = 1.0;          ///< e^{-c T0 / J}
+  double T0_s = 0.0;                   ///< control period
+  double flux_decay = 0.0;             ///< e^{-eta T0}
+  double flux_from_i_now_H = 0.0;      ///< ls (1 - sigma - e^{-eta T0}), multiplies i_k
+  double flux_from_i_next_H = 0.0;     ///< ls sigma, multiplies i_{k+1}
+  double torque_per_flux_A = 0.0;      ///< k_T n_p: tau = k_T n_p i^T J phi, N m per Wb A
+  double eta_per_s = 0.0;              ///< decay rate of the torque inside a period
+  double speed_decay = 1.0;            ///< e^{-c T0 / J}
   double speed_decay_minus_one = 0.0;  ///< e^{-c T0 / J} - 1 without cancellation (expm1)
-  double torque_to_speed = 0.0;      ///< (e^{-c T0/J} - e^{-eta T0}) / (J eta - c), rad/s per N m
-  double load_to_speed = 0.0;        ///< -(1 - e^{-c T0/J}) / c (-T0/J at c = 0), rad/s per N m
+  double torque_to_speed = 0.0;        ///< (e^{-c T0/J} - e^{-eta T0}) / (J eta - c), rad/s per N m
+  double load_to_speed = 0.0;          ///< -(1 - e^{-c T0/J}) / c (-T0/J at c = 0), rad/s per N m
 };
 
 /// Computes the coefficients in closed form, stable for c -> 0 and for J eta -> c. Requires
@@ -41,9 +41,12 @@ template <typename T>
 class ExactModel001 {
  public:
   explicit ExactModel001(const ExactModel001Coefficients& c) noexcept
-      : flux_decay_(T(c.flux_decay)), flux_from_i_now_H_(T(c.flux_from_i_now_H)),
-        flux_from_i_next_H_(T(c.flux_from_i_next_H)), torque_per_flux_A_(T(c.torque_per_flux_A)),
-        speed_decay_minus_one_(T(c.speed_decay_minus_one)), torque_to_speed_(T(c.torque_to_speed)),
+      : flux_decay_(T(c.flux_decay)),
+        flux_from_i_now_H_(T(c.flux_from_i_now_H)),
+        flux_from_i_next_H_(T(c.flux_from_i_next_H)),
+        torque_per_flux_A_(T(c.torque_per_flux_A)),
+        speed_decay_minus_one_(T(c.speed_decay_minus_one)),
+        torque_to_speed_(T(c.torque_to_speed)),
         load_to_speed_(T(c.load_to_speed)) {}
 
   /// Stator flux at t_{k+1} after the current steps to i_{k+1}, equation (15).

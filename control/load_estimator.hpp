@@ -41,8 +41,13 @@ template <typename T>
 class LoadEstimator {
  public:
   LoadEstimator(const ExactModel000Coefficients& c, const LoadEstimatorGains& gains) noexcept
-      : eta1_(T(c.eta1)), eta2_(T(c.eta2)), eta3_(T(c.eta3)), omega_decay_(T(c.omega_decay)),
-        load_to_omega_(T(c.load_to_omega)), l1_(T(gains.l1)), l2_(T(gains.l2)) {}
+      : eta1_(T(c.eta1)),
+        eta2_(T(c.eta2)),
+        eta3_(T(c.eta3)),
+        omega_decay_(T(c.omega_decay)),
+        load_to_omega_(T(c.load_to_omega)),
+        l1_(T(gains.l1)),
+        l2_(T(gains.l2)) {}
 
   T load_Nm() const noexcept { return load_; }
   T omega_mech_rad_s() const noexcept { return omega_; }

@@ -28,8 +28,12 @@ std::optional<ParameterProblem> find_invalid_parameter(const MotorParameters& m)
     std::string_view key;
     double value;
   };
-  const Positive positives[] = {{"Rs_Ohm", m.Rs_Ohm}, {"Ls_H", m.Ls_H},   {"Lm_H", m.Lm_H},
-                                {"Rr_Ohm", m.Rr_Ohm}, {"Lr_H", m.Lr_H},   {"J_kgm2", m.J_kgm2},
+  const Positive positives[] = {{"Rs_Ohm", m.Rs_Ohm},
+                                {"Ls_H", m.Ls_H},
+                                {"Lm_H", m.Lm_H},
+                                {"Rr_Ohm", m.Rr_Ohm},
+                                {"Lr_H", m.Lr_H},
+                                {"J_kgm2", m.J_kgm2},
                                 {"pole_pairs", static_cast<double>(m.pole_pairs)}};
   for (const auto& p : positives) {
     if (!std::isfinite(p.value)) return ParameterProblem{p.key, p.value, "must be finite"};

@@ -16,7 +16,8 @@ using PhaseValues = std::array<T, 3>;  ///< phases a, b, c
 /// alpha-beta from three phase values (their zero-sequence part is dropped).
 template <typename T>
 Vec2<T> clarke(const PhaseValues<T>& abc) noexcept {
-  return Vec2<T>((T(2) * abc[0] - abc[1] - abc[2]) / T(3), (abc[1] - abc[2]) / T(std::numbers::sqrt3));
+  return Vec2<T>((T(2) * abc[0] - abc[1] - abc[2]) / T(3),
+                 (abc[1] - abc[2]) / T(std::numbers::sqrt3));
 }
 
 /// Phase values (without zero sequence) from alpha-beta.
@@ -35,7 +36,7 @@ T svpwm_linear_limit_V(T v_bus_V) noexcept {
 template <typename T>
 struct SvpwmResult {
   PhaseValues<T> duty{T(0.5), T(0.5), T(0.5)};  ///< high-side on-time fractions, in [0, 1]
-  bool clipped = false;                          ///< the request exceeded the linear range
+  bool clipped = false;                         ///< the request exceeded the linear range
 };
 
 /// Duties that make the average phase-to-neutral voltages equal to u (alpha-beta), with the
@@ -52,7 +53,8 @@ SvpwmResult<T> svpwm(Vec2<T> u_alphabeta_V, T v_bus_V) noexcept {
   const T magnitude = u_alphabeta_V.norm();
   if (!(magnitude <= limit)) {  // also catches NaN
     result.clipped = true;
-    u_alphabeta_V = magnitude > limit ? Vec2<T>(u_alphabeta_V * (limit / magnitude)) : Vec2<T>::Zero();
+    u_alphabeta_V =
+        magnitude > limit ? Vec2<T>(u_alphabeta_V * (limit / magnitude)) : Vec2<T>::Zero();
   }
   const PhaseValues<T> v = inverse_clarke(u_alphabeta_V);
   const T offset = -(std::max({v[0], v[1], v[2]}) + std::min({v[0], v[1], v[2]})) / T(2);

@@ -110,16 +110,18 @@ typename Drive<T>::Estimate Drive<T>::estimate(const hal::AdcSample& sample) noe
   const Vec2 i_alphabeta = control::clarke(i_abc);
   record_.i_alpha_A = double(i_alphabeta.x());
   record_.i_beta_A = double(i_alphabeta.y());
-  e.x.i_s_AB_A = control::Rotation<T>::from_angle(pole_pairs_ * e.x.theta_mech_rad)
-                     .apply_inverse(i_alphabeta);
+  e.x.i_s_AB_A =
+      control::Rotation<T>::from_angle(pole_pairs_ * e.x.theta_mech_rad).apply_inverse(i_alphabeta);
 
   if (oracle_ != nullptr) {  // ideal sensors: current, speed and position are measured exactly
     const TrueState truth = oracle_->true_state();
     e.x.i_s_AB_A = Vec2(T(truth.i_s_A_A), T(truth.i_s_B_A));
     adc_saturated_ = false;  // the ADC is not used
-    const auto true_abc = control::inverse_clarke(Vec2(
-        control::Rotation<T>::from_angle(pole_pairs_ * T(truth.theta_mech_rad)).apply(e.x.i_s_AB_A)));
-    peak_phase_current_A_ = std::max({std::abs(true_abc[0]), std::abs(true_abc[1]), std::abs(true_abc[2])});
+    const auto true_abc = control::inverse_clarke(
+        Vec2(control::Rotation<T>::from_angle(pole_pairs_ * T(truth.theta_mech_rad))
+                 .apply(e.x.i_s_AB_A)));
+    peak_phase_current_A_ =
+        std::max({std::abs(true_abc[0]), std::abs(true_abc[1]), std::abs(true_abc[2])});
     e.x.omega_mech_rad_s = T(truth.omega_mech_rad_s);
     e.x.theta_mech_rad = T(truth.theta_mech_rad);
     if (config_.section_iv_load_estimator) {
@@ -154,8 +156,7 @@ control::InputDisk<T> Drive<T>::feasible_inputs(const control::RotorFrameState<T
 }
 
 template <typename T>
-control::Vec2<T> Drive<T>::magnetizing_input(const control::RotorFrameState<T>& x,
-                                             T flux2_ref_Wb2,
+control::Vec2<T> Drive<T>::magnetizing_input(const control::RotorFrameState<T>& x, T flux2_ref_Wb2,
                                              const control::InputDisk<T>& feasible) const noexcept {
   // Deadbeat current control along the flux (the A axis while there is none) to the current
   // that holds the reference flux in steady state, Phi = Lm I.
@@ -205,11 +206,13 @@ void Drive<T>::on_tick() noexcept {
       speed_ramp_.reset(speed_ramp_.limited() ? e.x.omega_mech_rad_s
                                               : T(references_.at_tick(k).omega_mech_rad_s));
     }
-    const T ramp_k1 = speed_ramp_.next(speed_ramp_.value(), T(references_.at_tick(k + 1).omega_mech_rad_s));
+    const T ramp_k1 =
+        speed_ramp_.next(speed_ramp_.value(), T(references_.at_tick(k + 1).omega_mech_rad_s));
     Reference ref_now = references_.at_tick(k + (latency ? 1 : 0));
     Reference ref = references_.at_tick(k + (latency ? 2 : 1));
     ref_now.omega_mech_rad_s = double(latency ? ramp_k1 : speed_ramp_.value());
-    ref.omega_mech_rad_s = double(latency ? speed_ramp_.next(ramp_k1, T(ref.omega_mech_rad_s)) : ramp_k1);
+    ref.omega_mech_rad_s =
+        double(latency ? speed_ramp_.next(ramp_k1, T(ref.omega_mech_rad_s)) : ramp_k1);
     speed_ramp_.reset(ramp_k1);
     const control::InputDisk<T> feasible = feasible_inputs(x, v_bus_V);
     Vec2 v = Vec2::Zero();

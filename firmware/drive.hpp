@@ -61,7 +61,8 @@ class Drive final : public hal::TickHandler {
 
   bool calibrate_adc(const hal::AdcSample& sample) noexcept;
   Estimate estimate(const hal::AdcSample& sample) noexcept;
-  control::InputDisk<T> feasible_inputs(const control::RotorFrameState<T>& x, T v_bus_V) const noexcept;
+  control::InputDisk<T> feasible_inputs(const control::RotorFrameState<T>& x,
+                                        T v_bus_V) const noexcept;
   Vec2 magnetizing_input(const control::RotorFrameState<T>& x, T flux2_ref_Wb2,
                          const control::InputDisk<T>& feasible) const noexcept;
   Vec2 compensation_AB(const control::RotorFrameState<T>& x) const noexcept;
@@ -88,8 +89,8 @@ class Drive final : public hal::TickHandler {
   int64_t calibration_sum_[3] = {0, 0, 0};
   T offset_code_[3] = {T(0), T(0), T(0)};
   uint32_t last_encoder_count_ = 0;
-  int64_t encoder_position_ = 0;  ///< counts within one revolution, [0, cpr)
-  bool encoder_started_ = false;   ///< the first reading has set the observer's angle
+  int64_t encoder_position_ = 0;       ///< counts within one revolution, [0, cpr)
+  bool encoder_started_ = false;       ///< the first reading has set the observer's angle
   Vec2 v_in_flight_V_ = Vec2::Zero();  ///< written last tick, acts over this period (latency 1)
   T peak_phase_current_A_ = T(0);      ///< largest phase current of this tick
   bool adc_saturated_ = false;         ///< a phase-current code on a rail this tick

@@ -8,7 +8,7 @@ namespace imd::firmware {
 enum class ControllerKind { dsmc };
 
 struct DriveConfig {
-  double sample_period_s = 1e-4;              ///< control period delta
+  double sample_period_s = 1e-4;  ///< control period delta
   ControllerKind controller = ControllerKind::dsmc;
   /// Drive the analog inner-feedback device (paper's hybrid scheme) instead of running (2)
   /// digitally through the PWM.
@@ -22,20 +22,20 @@ struct DriveConfig {
 
   // Control law.
   double max_accel_rad_s2 = std::numeric_limits<double>::infinity();  ///< speed reference ramp
-  double speed_reaching_pole = 0.0;          ///< e_{k+1} = pole e_k; 0 is the paper's deadbeat law
+  double speed_reaching_pole = 0.0;  ///< e_{k+1} = pole e_k; 0 is the paper's deadbeat law
   double flux_reaching_pole = 0.0;
 
   // Limits.
-  bool voltage_limited = true;               ///< false only to reproduce the paper (no limit)
-  double modulation_margin = 0.95;           ///< share of the SVPWM linear range the law may use
+  bool voltage_limited = true;      ///< false only to reproduce the paper (no limit)
+  double modulation_margin = 0.95;  ///< share of the SVPWM linear range the law may use
   double i_max_A = std::numeric_limits<double>::infinity();  ///< motor and inverter current limit
-  double current_margin = 0.95;              ///< share of i_max the law may plan for
+  double current_margin = 0.95;  ///< share of i_max the law may plan for
 
   // Start-up.
-  int adc_calibration_ticks = 256;           ///< offset measurement with the PWM off; 0 skips it
-  double adc_offset_limit_A = 0.5;           ///< a larger measured offset is a fault
-  double magnetizing_current_A = 0.0;        ///< 0: sqrt(flux2_ref)/Lm, capped at 0.9 i_max
-  double magnetized_fraction = 0.95;         ///< running once |Phi^|^2 >= this * reference
+  int adc_calibration_ticks = 256;     ///< offset measurement with the PWM off; 0 skips it
+  double adc_offset_limit_A = 0.5;     ///< a larger measured offset is a fault
+  double magnetizing_current_A = 0.0;  ///< 0: sqrt(flux2_ref)/Lm, capped at 0.9 i_max
+  double magnetized_fraction = 0.95;   ///< running once |Phi^|^2 >= this * reference
   double magnetizing_timeout_s = 2.0;
 
   // Estimation.
@@ -43,14 +43,14 @@ struct DriveConfig {
   /// Use the paper's Section IV estimators (flux observer and load estimator on a measured
   /// speed) instead of the encoder observer's speed and load.
   bool section_iv_load_estimator = false;
-  double load_estimator_pole = 0.99;          ///< double pole of the error matrix (13)
-  double min_flux2_Wb2 = 1e-3;                ///< below it B_k counts as singular
+  double load_estimator_pole = 0.99;  ///< double pole of the error matrix (13)
+  double min_flux2_Wb2 = 1e-3;        ///< below it B_k counts as singular
 
   // Protection (the full set comes with the drive application).
   double overcurrent_trip_A = std::numeric_limits<double>::infinity();
-  double bus_min_V = 20.0;                   ///< below: undervoltage (also a NaN reading)
-  double bus_max_V = 450.0;                  ///< above: overvoltage
-  uint32_t tick_budget_ns = 0;               ///< execution-time budget; 0: not checked (simulation)
+  double bus_min_V = 20.0;      ///< below: undervoltage (also a NaN reading)
+  double bus_max_V = 450.0;     ///< above: overvoltage
+  uint32_t tick_budget_ns = 0;  ///< execution-time budget; 0: not checked (simulation)
 };
 
 }  // namespace imd::firmware

@@ -9,28 +9,37 @@ enum class DriveState : uint8_t { calibrating, magnetizing, running, fault };
 
 enum class FaultCode : uint8_t {
   none = 0,
-  adc_offset,            ///< offset out of range at start-up
+  adc_offset,  ///< offset out of range at start-up
   overcurrent,
   magnetizing_timeout,
-  non_finite,            ///< NaN or Inf in the duty path
-  singular_control,      ///< B_k singular while running
+  non_finite,        ///< NaN or Inf in the duty path
+  singular_control,  ///< B_k singular while running
   bus_undervoltage,
   bus_overvoltage,
-  overrun,               ///< the tick took longer than its budget
+  overrun,  ///< the tick took longer than its budget
 };
 
 /// Stable lower-case name of a fault code, for logs and summaries.
 constexpr const char* fault_name(FaultCode code) noexcept {
   switch (code) {
-    case FaultCode::none: return "none";
-    case FaultCode::adc_offset: return "adc_offset";
-    case FaultCode::overcurrent: return "overcurrent";
-    case FaultCode::magnetizing_timeout: return "magnetizing_timeout";
-    case FaultCode::non_finite: return "non_finite";
-    case FaultCode::singular_control: return "singular_control";
-    case FaultCode::bus_undervoltage: return "bus_undervoltage";
-    case FaultCode::bus_overvoltage: return "bus_overvoltage";
-    case FaultCode::overrun: return "overrun";
+    case FaultCode::none:
+      return "none";
+    case FaultCode::adc_offset:
+      return "adc_offset";
+    case FaultCode::overcurrent:
+      return "overcurrent";
+    case FaultCode::magnetizing_timeout:
+      return "magnetizing_timeout";
+    case FaultCode::non_finite:
+      return "non_finite";
+    case FaultCode::singular_control:
+      return "singular_control";
+    case FaultCode::bus_undervoltage:
+      return "bus_undervoltage";
+    case FaultCode::bus_overvoltage:
+      return "bus_overvoltage";
+    case FaultCode::overrun:
+      return "overrun";
   }
   return "unknown";
 }
@@ -46,8 +55,8 @@ struct TickRecord {
   // References the law aimed at (for the step the input acts on).
   double omega_ref_rad_s = 0.0, flux2_ref_Wb2 = 0.0;
   // Command.
-  double v_A_V = 0.0, v_B_V = 0.0;           ///< v~ applied (after limiting)
-  double u_alpha_V = 0.0, u_beta_V = 0.0;    ///< stator voltage command
+  double v_A_V = 0.0, v_B_V = 0.0;         ///< v~ applied (after limiting)
+  double u_alpha_V = 0.0, u_beta_V = 0.0;  ///< stator voltage command
   double discriminant = 0.0, c_k = 0.0, det_B = 0.0;
   bool speed_saturated = false, flux_saturated = false, voltage_clipped = false;
   uint32_t exec_ns = 0;

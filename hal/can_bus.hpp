@@ -6,7 +6,7 @@
 namespace imd::hal {
 
 struct CanFrame {
-  uint16_t id = 0;  ///< 11-bit identifier
+  uint16_t id = 0;     ///< 11-bit identifier
   uint8_t length = 0;  ///< 0..8
   std::array<uint8_t, 8> data{};
 };

@@ -16,7 +16,7 @@ struct AdcScale {
   float phase_A_per_code = 0.0f;
   uint16_t phase_mid_code = 0;  ///< nominal code at zero current
   float bus_V_per_code = 0.0f;
-  uint16_t max_code = 0;        ///< full-scale code, 2^bits - 1
+  uint16_t max_code = 0;  ///< full-scale code, 2^bits - 1
 };
 
 class CurrentAdc {

@@ -36,7 +36,8 @@ double InductionMotorPlant::torque_Nm(const Vec2& i_s_A, const Vec2& flux_r_Wb) 
 }
 
 Vec2 InductionMotorPlant::flux_s_alphabeta_Wb() const noexcept {
-  return k_.sigma_H * state_.i_s_alphabeta_A + motor_.Lm_H / motor_.Lr_H * state_.flux_r_alphabeta_Wb;
+  return k_.sigma_H * state_.i_s_alphabeta_A +
+         motor_.Lm_H / motor_.Lr_H * state_.flux_r_alphabeta_Wb;
 }
 
 StateVector InductionMotorPlant::voltage_fed_derivative(const StateVector& x, const Vec2& u,
@@ -48,7 +49,8 @@ StateVector InductionMotorPlant::voltage_fed_derivative(const StateVector& x, co
   const Vec2 j_flux = control::J_times(flux);
   const double torque = torque_Nm(current, flux);
   StateVector dx;
-  dx.segment<2>(0) = -k_.alpha_per_s * flux + p_omega * j_flux + k_.alpha_per_s * motor_.Lm_H * current;
+  dx.segment<2>(0) =
+      -k_.alpha_per_s * flux + p_omega * j_flux + k_.alpha_per_s * motor_.Lm_H * current;
   dx.segment<2>(2) = k_.alpha_per_s * k_.beta_per_H * flux - p_omega * k_.beta_per_H * j_flux -
                      k_.gamma_per_s * current + u / k_.sigma_H;
   dx(4) = (torque - motor_.friction_Nms * omega - load_Nm) / motor_.J_kgm2;
@@ -91,7 +93,8 @@ Vec2 InductionMotorPlant::analog_feedback_voltage_V(const Vec2& v_AB_V) const no
 void InductionMotorPlant::step_analog_feedback(const Vec2& v_AB_V, double load_Nm) noexcept {
   integrate_voltage_fed(
       [&](const StateVector& x) -> Vec2 {
-        return feedback_2(k_, motor_.pole_pairs, x.segment<2>(0), x.segment<2>(2), x(4), x(5), v_AB_V);
+        return feedback_2(k_, motor_.pole_pairs, x.segment<2>(0), x.segment<2>(2), x(4), x(5),
+                          v_AB_V);
       },
       load_Nm);
 }

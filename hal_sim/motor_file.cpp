@@ -14,13 +14,20 @@ namespace {
 
 const char* type_name(const toml::node& node) {
   switch (node.type()) {
-    case toml::node_type::string: return "a string";
-    case toml::node_type::integer: return "an integer";
-    case toml::node_type::floating_point: return "a number";
-    case toml::node_type::boolean: return "a boolean";
-    case toml::node_type::table: return "a table";
-    case toml::node_type::array: return "an array";
-    default: return "a date or time";
+    case toml::node_type::string:
+      return "a string";
+    case toml::node_type::integer:
+      return "an integer";
+    case toml::node_type::floating_point:
+      return "a number";
+    case toml::node_type::boolean:
+      return "a boolean";
+    case toml::node_type::table:
+      return "a table";
+    case toml::node_type::array:
+      return "an array";
+    default:
+      return "a date or time";
   }
 }
 
@@ -92,8 +99,8 @@ control::MotorParameters parse_motor_table(const toml::table& document, std::str
   p.pole_pairs = require_integer(*motor, "pole_pairs", source);
   p.friction_Nms = require_number(*motor, "friction_Nms", source);
   if (const auto problem = control::find_invalid_parameter(p)) {
-    throw ConfigError(fmt::format("{}: motor.{} = {}: {}", source, problem->key, problem->value,
-                                  problem->rule));
+    throw ConfigError(
+        fmt::format("{}: motor.{} = {}: {}", source, problem->key, problem->value, problem->rule));
   }
   return p;
 }

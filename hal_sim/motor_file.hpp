@@ -6,9 +6,9 @@
 ///   Lr_H = 0.4128        J_kgm2 = 0.01    pole_pairs = 1   friction_Nms = 0.0
 ///
 /// All eight keys are required; other keys in the table are free (names, ratings). Host only.
+#include <toml++/toml.h>
 #include <filesystem>
 #include <string_view>
-#include <toml++/toml.h>
 
 #include "control/motor_parameters.hpp"
 

@@ -69,7 +69,8 @@ class Reader {
   /// A positive number, or inf for "no limit".
   double positive_or_inf(std::string_view path) {
     const toml::node* node = find(path);
-    if (node != nullptr && node->is_floating_point() && node->as_floating_point()->get() == std::numeric_limits<double>::infinity()) {
+    if (node != nullptr && node->is_floating_point() &&
+        node->as_floating_point()->get() == std::numeric_limits<double>::infinity()) {
       return std::numeric_limits<double>::infinity();
     }
     return positive(path, std::numeric_limits<double>::infinity());
@@ -135,7 +136,8 @@ class Reader {
  private:
   void walk(const toml::table& table, const std::string& prefix) const {
     for (const auto& [key, node] : table) {
-      const std::string path = prefix.empty() ? std::string(key.str()) : prefix + "." + std::string(key.str());
+      const std::string path =
+          prefix.empty() ? std::string(key.str()) : prefix + "." + std::string(key.str());
       if (accepted_.count(path)) continue;
       if (const auto* child = node.as_table()) {
         walk(*child, path);
@@ -171,7 +173,8 @@ void apply_override(toml::table& doc, const std::string& assignment, const std::
   std::vector<std::string> parts;
   std::stringstream stream(path);
   for (std::string part; std::getline(stream, part, '.');) parts.push_back(part);
-  if (parts.size() < 2) throw ConfigError(fmt::format("--set {}: expected table.key=VALUE", assignment));
+  if (parts.size() < 2)
+    throw ConfigError(fmt::format("--set {}: expected table.key=VALUE", assignment));
   // The motor table admits free keys, so an override there must name a contract key or one
   // the file has: a typo must not pass silently.
   if (parts[0] == "motor" && !kMotorKeys.count(parts[1]) && !doc.at_path(path)) {
@@ -185,7 +188,8 @@ void apply_override(toml::table& doc, const std::string& assignment, const std::
       child = table->get(parts[i]);
     }
     table = child->as_table();
-    if (table == nullptr) throw ConfigError(fmt::format("{}: --set {}: {} is not a table", source, path, parts[i]));
+    if (table == nullptr)
+      throw ConfigError(fmt::format("{}: --set {}: {} is not a table", source, path, parts[i]));
   }
   toml::table parsed = parse_override_value(text);
   table->insert_or_assign(parts.back(), std::move(*parsed.get("value")));
@@ -233,7 +237,8 @@ void read_load(Reader& r, Scenario& s) {
 
 }  // namespace
 
-Scenario load_scenario(const std::filesystem::path& path, const std::vector<std::string>& overrides) {
+Scenario load_scenario(const std::filesystem::path& path,
+                       const std::vector<std::string>& overrides) {
   toml::table doc = parse_toml_file(path);
   const std::string source = path.string();
   if (const toml::node* motor_file = doc.get("motor_file")) {
@@ -261,7 +266,8 @@ Scenario load_scenario(const std::filesystem::path& path, const std::vector<std:
 
   s.sample_period_s = r.positive("drive.sample_period_s", 1e-4);
   if (s.sample_period_s < 1e-6 || s.sample_period_s > 1e-2) {
-    r.fail("drive.sample_period_s", fmt::format("= {}: must be in [1e-6, 1e-2] s", s.sample_period_s));
+    r.fail("drive.sample_period_s",
+           fmt::format("= {}: must be in [1e-6, 1e-2] s", s.sample_period_s));
   }
   s.controller = r.choice("drive.controller", "dsmc", {"dsmc"});
   s.precision = r.choice("drive.precision", "double", {"double", "float"});
@@ -270,7 +276,8 @@ Scenario load_scenario(const std::filesystem::path& path, const std::vector<std:
   for (auto [key, value] : {std::pair{"drive.speed_reaching_pole", &s.speed_reaching_pole},
                             std::pair{"drive.flux_reaching_pole", &s.flux_reaching_pole}}) {
     *value = r.number(key, 0.0);
-    if (!(*value >= 0.0 && *value < 1.0)) r.fail(key, fmt::format("= {}: must be in [0, 1)", *value));
+    if (!(*value >= 0.0 && *value < 1.0))
+      r.fail(key, fmt::format("= {}: must be in [0, 1)", *value));
   }
 
   read_speed_reference(r, s);
@@ -292,35 +299,42 @@ Scenario load_scenario(const std::filesystem::path& path, const std::vector<std:
 
   s.v_bus_V = r.positive("inverter.v_bus_V", 311.0);
   if (s.v_bus_V >= s.adc.bus_full_scale_V) {
-    r.fail("inverter.v_bus_V", fmt::format("= {}: must be below sensors.adc_bus_full_scale_V", s.v_bus_V));
+    r.fail("inverter.v_bus_V",
+           fmt::format("= {}: must be below sensors.adc_bus_full_scale_V", s.v_bus_V));
   }
   s.i_max_A = r.positive_or_inf("inverter.i_max_A");
   s.limit_voltage = r.boolean("inverter.limit_voltage", true);
 
   s.section_iv = r.boolean("observers.section_iv", false);
   if (s.section_iv && !s.ideal_sensors) {
-    r.fail("observers.section_iv", "needs sensors.ideal = true (the Section IV estimators take the measured speed)");
+    r.fail("observers.section_iv",
+           "needs sensors.ideal = true (the Section IV estimators take the measured speed)");
   }
   s.encoder_bandwidth_rad_s = r.positive("observers.encoder_bandwidth_rad_s", 400.0);
   s.load_estimator_pole = r.number("observers.load_estimator_pole", 0.99);
   if (!(s.load_estimator_pole > 0.0 && s.load_estimator_pole < 1.0)) {
-    r.fail("observers.load_estimator_pole", fmt::format("= {}: must be in (0, 1)", s.load_estimator_pole));
+    r.fail("observers.load_estimator_pole",
+           fmt::format("= {}: must be in (0, 1)", s.load_estimator_pole));
   }
 
   s.duration_s = r.positive("simulation.duration_s", 1.0);
-  if (s.duration_s > 3600.0) r.fail("simulation.duration_s", fmt::format("= {}: must be <= 3600 s", s.duration_s));
+  if (s.duration_s > 3600.0)
+    r.fail("simulation.duration_s", fmt::format("= {}: must be <= 3600 s", s.duration_s));
   s.substeps = static_cast<int>(r.integer("simulation.substeps", 10, 1, 10000));
-  s.inner_feedback = r.choice("simulation.inner_feedback", "digital", {"digital", "ideal_analog"}) == "digital"
-                         ? InnerFeedback::digital
-                         : InnerFeedback::ideal_analog;
+  s.inner_feedback =
+      r.choice("simulation.inner_feedback", "digital", {"digital", "ideal_analog"}) == "digital"
+          ? InnerFeedback::digital
+          : InnerFeedback::ideal_analog;
   s.pwm_latency_ticks = static_cast<int>(r.integer("simulation.pwm_latency_ticks", 1, 0, 1));
-  s.seed = static_cast<uint64_t>(r.integer("simulation.seed", 1, 0, std::numeric_limits<int64_t>::max()));
+  s.seed = static_cast<uint64_t>(
+      r.integer("simulation.seed", 1, 0, std::numeric_limits<int64_t>::max()));
   s.initial_flux2_Wb2 = r.non_negative("simulation.initial_flux2_Wb2", 0.0);
   s.initial_theta_mech_rad = r.number("simulation.initial_theta_mech_rad", 0.0);
 
   s.settle_s = r.non_negative("metrics.settle_s", 0.5);
   if (s.settle_s >= s.duration_s) {
-    r.fail("metrics.settle_s", fmt::format("= {}: must be below simulation.duration_s", s.settle_s));
+    r.fail("metrics.settle_s",
+           fmt::format("= {}: must be below simulation.duration_s", s.settle_s));
   }
   r.reject_unknown();
   return s;

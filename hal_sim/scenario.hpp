@@ -46,7 +46,7 @@ struct Scenario {
 
   // [inverter]
   double v_bus_V = 311.0;
-  double i_max_A = 0.0;  ///< inf: no current limit
+  double i_max_A = 0.0;       ///< inf: no current limit
   bool limit_voltage = true;  ///< false: the law ignores the bus (the paper states no limit)
 
   // [observers]
@@ -60,7 +60,7 @@ struct Scenario {
   InnerFeedback inner_feedback = InnerFeedback::digital;
   int pwm_latency_ticks = 1;
   uint64_t seed = 1;
-  double initial_flux2_Wb2 = 0.0;  ///< start magnetized at rest with this squared flux
+  double initial_flux2_Wb2 = 0.0;       ///< start magnetized at rest with this squared flux
   double initial_theta_mech_rad = 0.0;  ///< rotor position at the start
 
   // [metrics]

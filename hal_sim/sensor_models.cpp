@@ -40,8 +40,8 @@ uint32_t encoder_count(double theta_mech_rad, uint32_t counts_per_rev) noexcept 
 }
 
 control::Vec2<double> inverter_output_V(const hal::PhaseDuties& duty, double v_bus_V) noexcept {
-  return control::clarke(control::PhaseValues<double>{duty[0] * v_bus_V, duty[1] * v_bus_V,
-                                                      duty[2] * v_bus_V});
+  return control::clarke(
+      control::PhaseValues<double>{duty[0] * v_bus_V, duty[1] * v_bus_V, duty[2] * v_bus_V});
 }
 
 }  // namespace imd::sim

@@ -14,10 +14,10 @@ namespace imd::sim {
 
 struct AdcModelConfig {
   int bits = 12;
-  double full_scale_A = 10.0;                 ///< codes span -full_scale_A .. +full_scale_A
-  double noise_A = 0.0;                       ///< standard deviation of the phase-current noise
+  double full_scale_A = 10.0;                     ///< codes span -full_scale_A .. +full_scale_A
+  double noise_A = 0.0;                           ///< standard deviation of the phase-current noise
   std::array<double, 3> offset_A{0.0, 0.0, 0.0};  ///< offset of each phase channel
-  double bus_full_scale_V = 500.0;            ///< codes span 0 .. bus_full_scale_V
+  double bus_full_scale_V = 500.0;                ///< codes span 0 .. bus_full_scale_V
   double bus_noise_V = 0.0;
 };
 

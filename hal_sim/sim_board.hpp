@@ -24,8 +24,8 @@ enum class InnerFeedback {
 
 struct SimBoardConfig {
   double period_s = 1e-4;
-  int substeps = 10;                 ///< RK4 steps per period
-  int pwm_latency_ticks = 1;         ///< 0 or 1
+  int substeps = 10;          ///< RK4 steps per period
+  int pwm_latency_ticks = 1;  ///< 0 or 1
   InnerFeedback inner_feedback = InnerFeedback::digital;
   double v_bus_V = 311.0;
   uint32_t encoder_cpr = 8192;

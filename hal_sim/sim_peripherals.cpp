@@ -24,7 +24,9 @@ bool SimCan::inject(const hal::CanFrame& frame) {
   return true;
 }
 
-std::deque<hal::CanFrame> SimCan::take_sent() { return std::exchange(sent_, {}); }
+std::deque<hal::CanFrame> SimCan::take_sent() {
+  return std::exchange(sent_, {});
+}
 
 uint64_t SimTimer::execution_clock_ns() const noexcept {
   return static_cast<uint64_t>(std::chrono::duration_cast<std::chrono::nanoseconds>(

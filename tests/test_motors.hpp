@@ -25,12 +25,13 @@ inline std::string source_path(const std::string& relative) {
 
 inline std::vector<TestMotor> test_motors() {
   return {
-      {"seed000", sim::load_motor_file(source_path("hal_sim/motors/seed000.toml")), 0.5, 3.0,
-       300.0, 250.0, 1.0},
+      {"seed000", sim::load_motor_file(source_path("hal_sim/motors/seed000.toml")), 0.5, 3.0, 300.0,
+       250.0, 1.0},
       {"seed001", sim::load_motor_file(source_path("hal_sim/motors/seed001.toml")), 1.0, 200.0,
        300.0, 150.0, 200.0},
-      {"small_4pole_750W", sim::load_motor_file(source_path("tests/data/motors/small_4pole_750W.toml")),
-       0.8, 2.0, 300.0, 150.0, 4.0},
+      {"small_4pole_750W",
+       sim::load_motor_file(source_path("tests/data/motors/small_4pole_750W.toml")), 0.8, 2.0,
+       300.0, 150.0, 4.0},
       {"six_pole_7kW", sim::load_motor_file(source_path("tests/data/motors/six_pole_7kW.toml")),
        0.9, 25.0, 300.0, 100.0, 60.0},
   };

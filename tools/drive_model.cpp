@@ -24,9 +24,14 @@ using nlohmann::ordered_json;
 constexpr int kExitBadInput = 2;
 
 ordered_json motor_json(const MotorParameters& m) {
-  return {{"Rs_Ohm", m.Rs_Ohm}, {"Ls_H", m.Ls_H},     {"Lm_H", m.Lm_H},
-          {"Rr_Ohm", m.Rr_Ohm}, {"Lr_H", m.Lr_H},     {"J_kgm2", m.J_kgm2},
-          {"pole_pairs", m.pole_pairs}, {"friction_Nms", m.friction_Nms}};
+  return {{"Rs_Ohm", m.Rs_Ohm},
+          {"Ls_H", m.Ls_H},
+          {"Lm_H", m.Lm_H},
+          {"Rr_Ohm", m.Rr_Ohm},
+          {"Lr_H", m.Lr_H},
+          {"J_kgm2", m.J_kgm2},
+          {"pole_pairs", m.pole_pairs},
+          {"friction_Nms", m.friction_Nms}};
 }
 
 ordered_json seed000_json(const MotorParameters& m, double delta_s) {
@@ -98,8 +103,7 @@ int main(int argc, char** argv) {
       "discretize", "Print the seed000 (paper 000) and seed001 (paper 001) coefficients as JSON");
   discretize->add_option("--motor", motor_path, "Motor file (TOML with a [motor] table)")
       ->required();
-  discretize
-      ->add_option("--sample-period-s", delta_s, "Sample period delta of the paper-000 model")
+  discretize->add_option("--sample-period-s", delta_s, "Sample period delta of the paper-000 model")
       ->check(kPeriod)
       ->capture_default_str();
   discretize->add_option("--control-period-s", T0_s, "Control period T0 of the paper-001 model")

@@ -39,8 +39,7 @@ TEST(PlantSteadyState, BalancedSupplyMatchesTheEquivalentCircuit) {
   const Complex i_stator = voltage_V * z22 / det;
   const Complex i_rotor = -voltage_V * z21 / det;
   // Air-gap power over synchronous mechanical speed; 3/2 for peak-value space vectors.
-  const double torque_Nm =
-      1.5 * m.pole_pairs * std::norm(i_rotor) * m.Rr_Ohm / slip_rad_s;
+  const double torque_Nm = 1.5 * m.pole_pairs * std::norm(i_rotor) * m.Rr_Ohm / slip_rad_s;
 
   // The voltage is held over steps of h = 1 us and sampled at mid-step, so the staircase has
   // the sinusoid's phase. Its fundamental is smaller by (we h)^2/24 = 4e-9, and the ripple
@@ -87,10 +86,12 @@ TEST(PlantSteadyState, DcInjectionBrakingTorque) {
     const double alpha = m.Rr_Ohm / m.Lr_H;
     const double w = m.pole_pairs * omega_mech_rad_s;
     const double expected_torque = -1.5 * m.pole_pairs * m.Lm_H * m.Lm_H / m.Lr_H *
-                                   expected_current.squaredNorm() * alpha * w / (alpha * alpha + w * w);
+                                   expected_current.squaredNorm() * alpha * w /
+                                   (alpha * alpha + w * w);
     // Constant input: RK4 at h = 1e-5 s converges to the exact equilibrium (truncation acts on
     // the decaying transient only), so what is left is rounding: 1e-9 relative.
-    EXPECT_LE((plant.state().i_s_alphabeta_A - expected_current).norm() / expected_current.norm(), 1e-9);
+    EXPECT_LE((plant.state().i_s_alphabeta_A - expected_current).norm() / expected_current.norm(),
+              1e-9);
     EXPECT_NEAR(plant.torque_Nm(), expected_torque, 1e-9 * std::abs(expected_torque));
   }
 }

@@ -34,9 +34,9 @@ TEST(Seed000Paper, SectionIvObserversConverge) {
   // The paper's flux observer starts from zero; the drive holds the magnetizing current until
   // the estimate reaches 95 % of the reference, and ramps the speed reference (2000 rad/s^2) to
   // catch up with the sine afterwards.
-  const Scenario s = scenario("seed000_paper.toml", {"observers.section_iv=true",
-                                                      "drive.max_accel_rad_s2=2000",
-                                                      "metrics.settle_s=0.5"});
+  const Scenario s = scenario(
+      "seed000_paper.toml",
+      {"observers.section_iv=true", "drive.max_accel_rad_s2=2000", "metrics.settle_s=0.5"});
   const double a11 = control::discretize_seed000(s.motor, s.sample_period_s).a11;
   std::vector<SimRow> rows;
   rows.reserve(80001);
@@ -50,8 +50,10 @@ TEST(Seed000Paper, SectionIvObserversConverge) {
   const double e0_B = rows[0].flux_B_Wb - rows[0].flux_B_est_Wb;
   for (int k = 0; k <= 1000; ++k) {
     const double expected = std::pow(a11, k);
-    ASSERT_NEAR(rows[k].flux_A_Wb - rows[k].flux_A_est_Wb, expected * e0_A, 1e-9 * std::abs(e0_A)) << k;
-    ASSERT_NEAR(rows[k].flux_B_Wb - rows[k].flux_B_est_Wb, expected * e0_B, 1e-9 * std::abs(e0_A)) << k;
+    ASSERT_NEAR(rows[k].flux_A_Wb - rows[k].flux_A_est_Wb, expected * e0_A, 1e-9 * std::abs(e0_A))
+        << k;
+    ASSERT_NEAR(rows[k].flux_B_Wb - rows[k].flux_B_est_Wb, expected * e0_B, 1e-9 * std::abs(e0_A))
+        << k;
   }
   // Load: within 2 % of the 1 N m step, 100 ms after each step (square wave, 1 s period).
   for (double step_s = 0.5; step_s < s.duration_s; step_s += 0.5) {
@@ -81,14 +83,16 @@ TEST(Seed000Realistic, MeetsTheTrackingAndLimitTargets) {
   EXPECT_LE(r.speed_rms_err_rad_s, 1.5 * 0.079);
   EXPECT_LE(r.flux2_rms_err_Wb2, 1.5 * 1.52e-4);
   EXPECT_LE(r.saturated_fraction, 1.5 * 0.30);
-  std::printf("realistic: speed rms %.4f rad/s, flux2 rms %.3e Wb^2, i peak %.3f A, saturated %.3f\n",
-              r.speed_rms_err_rad_s, r.flux2_rms_err_Wb2, r.i_peak_total_A, r.saturated_fraction);
+  std::printf(
+      "realistic: speed rms %.4f rad/s, flux2 rms %.3e Wb^2, i peak %.3f A, saturated %.3f\n",
+      r.speed_rms_err_rad_s, r.flux2_rms_err_Wb2, r.i_peak_total_A, r.saturated_fraction);
 }
 
 TEST(Seed000Realistic, StartsFromAnyRotorAngle) {
   // The encoder observer takes its first angle from the encoder; a rotor at rest at 3.1 rad
   // must give the same performance as at 0 (0.087 against 0.079 rad/s RMS measured).
-  const Summary r = run_scenario(scenario("seed000_realistic.toml", {"simulation.initial_theta_mech_rad=3.1"}));
+  const Summary r =
+      run_scenario(scenario("seed000_realistic.toml", {"simulation.initial_theta_mech_rad=3.1"}));
   EXPECT_TRUE(r.faults.empty());
   EXPECT_LE(r.speed_rms_err_rad_s, 1.5 * 0.079);
   EXPECT_LE(r.i_peak_total_A, 6.0);
@@ -98,9 +102,9 @@ TEST(Seed000Paper, DigitalInnerFeedbackStaysCloseToTheAnalogLaw) {
   // Ideal sensors, no latency, a 3000 V bus so that nothing clips: what is left is running (2)
   // sampled and held. The held voltage is rotated to the middle of its period; measured
   // flux^2 RMS 1.0e-7 Wb^2 with it, 3.6e-7 without, speed RMS 8.5e-6 rad/s (analog: 2e-11).
-  const Summary r = run_scenario(scenario(
-      "seed000_paper.toml", {"inverter.v_bus_V=3000", "sensors.adc_bus_full_scale_V=4000",
-                             "simulation.inner_feedback=digital"}));
+  const Summary r = run_scenario(
+      scenario("seed000_paper.toml", {"inverter.v_bus_V=3000", "sensors.adc_bus_full_scale_V=4000",
+                                      "simulation.inner_feedback=digital"}));
   EXPECT_TRUE(r.faults.empty());
   EXPECT_LE(r.flux2_rms_err_Wb2, 2e-7);
   EXPECT_LE(r.speed_rms_err_rad_s, 2e-5);

@@ -23,8 +23,12 @@ void* operator new(std::size_t size) {
   if (void* p = std::malloc(size ? size : 1)) return p;
   throw std::bad_alloc();
 }
-void operator delete(void* p) noexcept { std::free(p); }
-void operator delete(void* p, std::size_t) noexcept { std::free(p); }
+void operator delete(void* p) noexcept {
+  std::free(p);
+}
+void operator delete(void* p, std::size_t) noexcept {
+  std::free(p);
+}
 
 namespace imd::firmware {
 namespace {
@@ -65,8 +69,12 @@ void run_without_allocation() {
   EXPECT_EQ(g_allocations.load(), 0);
 }
 
-TEST(DriveTick, NeverAllocatesInDouble) { run_without_allocation<double>(); }
-TEST(DriveTick, NeverAllocatesInFloat) { run_without_allocation<float>(); }
+TEST(DriveTick, NeverAllocatesInDouble) {
+  run_without_allocation<double>();
+}
+TEST(DriveTick, NeverAllocatesInFloat) {
+  run_without_allocation<float>();
+}
 
 TEST(DriveTick, OvercurrentTurnsThePwmOffInTheSameTick) {
   sim::SimBoard board(test::test_motors()[0].parameters, {});
@@ -113,7 +121,8 @@ TEST(DriveTick, BusUnderAndOvervoltageTrip) {
     config.bus_max_V = 450.0;
     Rig rig(board_config, config);
     for (int k = 0; k < 300; ++k) rig.board.run_tick();  // past the offset calibration
-    EXPECT_EQ(rig.drive.fault(), bus_V < 200.0 ? FaultCode::bus_undervoltage : FaultCode::bus_overvoltage);
+    EXPECT_EQ(rig.drive.fault(),
+              bus_V < 200.0 ? FaultCode::bus_undervoltage : FaultCode::bus_overvoltage);
     EXPECT_FALSE(rig.board.pwm().enabled());
   }
 }

@@ -108,8 +108,9 @@ TEST_F(DsmcTest, SaturatedFluxChannelMovesTowardsTheReference) {
   EXPECT_GT(next.flux_r_AB_Wb.squaredNorm(), coasting.flux_r_AB_Wb.squaredNorm());
   // The flux channel took the whole disk in the direction of the flux: the largest increase
   // that 300 V can give, b1 300 V along Phi.
-  const double best = (coasting.flux_r_AB_Wb + coefficients.b1 * 300.0 *
-                                                   coasting.flux_r_AB_Wb.normalized()).squaredNorm();
+  const double best =
+      (coasting.flux_r_AB_Wb + coefficients.b1 * 300.0 * coasting.flux_r_AB_Wb.normalized())
+          .squaredNorm();
   EXPECT_NEAR(next.flux_r_AB_Wb.squaredNorm(), best, 1e-6 * best);
 }
 

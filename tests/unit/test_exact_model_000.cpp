@@ -98,23 +98,33 @@ TEST(ExactModel000, OneStepMatchesFineIntegrationOfThePlant) {
       const auto to_rotor = Rotation<double>::from_angle(p * s.theta_mech_rad);
 
       const RotorFrameState<double> predicted = model.predict(d.x, d.v_AB_V, d.load_Nm);
-      worst_flux = std::max(worst_flux, relative_error(predicted.flux_r_AB_Wb,
-                                                       to_rotor.apply_inverse(s.flux_r_alphabeta_Wb)));
-      worst_current = std::max(worst_current, relative_error(predicted.i_s_AB_A,
-                                                             to_rotor.apply_inverse(s.i_s_alphabeta_A)));
-      worst_speed = std::max(worst_speed, relative_error(predicted.omega_mech_rad_s, s.omega_mech_rad_s));
-      worst_position = std::max(worst_position, relative_error(predicted.theta_mech_rad, s.theta_mech_rad));
+      worst_flux = std::max(
+          worst_flux,
+          relative_error(predicted.flux_r_AB_Wb, to_rotor.apply_inverse(s.flux_r_alphabeta_Wb)));
+      worst_current =
+          std::max(worst_current,
+                   relative_error(predicted.i_s_AB_A, to_rotor.apply_inverse(s.i_s_alphabeta_A)));
+      worst_speed =
+          std::max(worst_speed, relative_error(predicted.omega_mech_rad_s, s.omega_mech_rad_s));
+      worst_position =
+          std::max(worst_position, relative_error(predicted.theta_mech_rad, s.theta_mech_rad));
       // The increments, against the size of their terms: sensitive to every coefficient.
       const auto step = model.increment(d.x, d.v_AB_V, d.load_Nm);
       const auto scale = increment_scale(coefficients, d);
-      worst_speed_step = std::max(worst_speed_step, std::abs(step.omega_mech_rad_s -
-                                  (s.omega_mech_rad_s - d.x.omega_mech_rad_s)) / scale.omega_mech_rad_s);
-      worst_position_step = std::max(worst_position_step, std::abs(step.theta_mech_rad -
-                                     (s.theta_mech_rad - d.x.theta_mech_rad)) / scale.theta_mech_rad);
+      worst_speed_step =
+          std::max(worst_speed_step,
+                   std::abs(step.omega_mech_rad_s - (s.omega_mech_rad_s - d.x.omega_mech_rad_s)) /
+                       scale.omega_mech_rad_s);
+      worst_position_step =
+          std::max(worst_position_step,
+                   std::abs(step.theta_mech_rad - (s.theta_mech_rad - d.x.theta_mech_rad)) /
+                       scale.theta_mech_rad);
     }
-    std::printf("%-18s worst relative error: flux %.2e current %.2e speed %.2e position %.2e"
-                " | increments: speed %.2e position %.2e\n", motor.name.c_str(), worst_flux,
-                worst_current, worst_speed, worst_position, worst_speed_step, worst_position_step);
+    std::printf(
+        "%-18s worst relative error: flux %.2e current %.2e speed %.2e position %.2e"
+        " | increments: speed %.2e position %.2e\n",
+        motor.name.c_str(), worst_flux, worst_current, worst_speed, worst_position,
+        worst_speed_step, worst_position_step);
     EXPECT_LE(worst_flux, kExactnessTolerance);
     EXPECT_LE(worst_current, kExactnessTolerance);
     EXPECT_LE(worst_speed, kExactnessTolerance);
@@ -164,8 +174,12 @@ TEST(ExactModel000, CoefficientsMatchQuadratureOfTheMinors) {
     const double eta[3] = {c.eta1, c.eta2, c.eta3}, kappa[3] = {c.kappa1, c.kappa2, c.kappa3};
     for (int i = 0; i < 3; ++i) {
       const auto [j, l] = pairs[i];
-      const double eta_q = signs[i] * mu * simpson([&](double u) { return minor(u, j, l) * speed_weight(u); }, kDelta_s, 1600);
-      const double kappa_q = signs[i] * mu * simpson([&](double u) { return minor(u, j, l) * position_weight(u); }, kDelta_s, 1600);
+      const double eta_q =
+          signs[i] * mu *
+          simpson([&](double u) { return minor(u, j, l) * speed_weight(u); }, kDelta_s, 1600);
+      const double kappa_q =
+          signs[i] * mu *
+          simpson([&](double u) { return minor(u, j, l) * position_weight(u); }, kDelta_s, 1600);
       EXPECT_NEAR(eta[i], eta_q, 1e-12 * std::abs(eta_q)) << "eta" << i + 1;
       EXPECT_NEAR(kappa[i], kappa_q, 1e-12 * std::abs(kappa_q)) << "kappa" << i + 1;
     }
@@ -200,7 +214,9 @@ TEST(ExactModel000, Eta1MatchesItsClosedForm) {
     if (f == 0.0) {
       const double paper = k.mu_per_kgm2 * (std::exp(kDelta_s * trace) - 1.0) / trace;
       // The paper's form cancels in e^x - 1 for small x: about 1e-16 / |x| relative.
-      EXPECT_NEAR(c.eta1, paper, 1e-16 / std::abs(kDelta_s * trace) * std::abs(paper) + kExpmTolerance * std::abs(paper));
+      EXPECT_NEAR(
+          c.eta1, paper,
+          1e-16 / std::abs(kDelta_s * trace) * std::abs(paper) + kExpmTolerance * std::abs(paper));
     }
   }
 }
@@ -260,8 +276,10 @@ TEST(ExactModel000, FloatPredictorStaysCloseToDouble) {
       const auto step_d = model_d.increment(d.x, d.v_AB_V, d.load_Nm);
       const auto step_f = model_f.increment(xf, d.v_AB_V.cast<float>(), float(d.load_Nm));
       const auto scale = increment_scale(coefficients, d);
-      EXPECT_LE(std::abs(step_f.omega_mech_rad_s - step_d.omega_mech_rad_s), 1e-6 * scale.omega_mech_rad_s);
-      EXPECT_LE(std::abs(step_f.theta_mech_rad - step_d.theta_mech_rad), 1e-6 * scale.theta_mech_rad);
+      EXPECT_LE(std::abs(step_f.omega_mech_rad_s - step_d.omega_mech_rad_s),
+                1e-6 * scale.omega_mech_rad_s);
+      EXPECT_LE(std::abs(step_f.theta_mech_rad - step_d.theta_mech_rad),
+                1e-6 * scale.theta_mech_rad);
     }
   }
 }

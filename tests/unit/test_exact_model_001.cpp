@@ -37,8 +37,11 @@ Draw random_draw(std::mt19937_64& rng, const test::TestMotor& m) {
     return Vec2<double>(r * std::cos(a), r * std::sin(a));
   };
   const auto sign = [&] { return std::bernoulli_distribution(0.5)(rng) ? -1.0 : 1.0; };
-  return {vector(m.flux_Wb), vector(m.current_A), vector(m.current_A),
-          sign() * m.speed_rad_s * unit(rng), std::uniform_real_distribution<double>(0.5, 6.0)(rng),
+  return {vector(m.flux_Wb),
+          vector(m.current_A),
+          vector(m.current_A),
+          sign() * m.speed_rad_s * unit(rng),
+          std::uniform_real_distribution<double>(0.5, 6.0)(rng),
           sign() * m.load_Nm * unit(rng)};
 }
 
@@ -62,20 +65,23 @@ TEST(ExactModel001, OneStepMatchesTheCurrentFedPlant) {
     for (int trial = 0; trial < 200; ++trial) {
       const Draw d = random_draw(rng, motor);
       const auto rotor = Rotation<double>::from_angle(m.pole_pairs * d.theta_mech_rad);
-      plant.set_state({d.flux_r_alphabeta_Wb, rotor.apply(d.i_now_AB_A), d.omega_mech_rad_s,
-                       d.theta_mech_rad});
+      plant.set_state(
+          {d.flux_r_alphabeta_Wb, rotor.apply(d.i_now_AB_A), d.omega_mech_rad_s, d.theta_mech_rad});
       const Vec2<double> flux_now = stator_flux_AB(m, plant.state(), d.i_now_AB_A);
       const double torque_now = model.torque_Nm(flux_now, d.i_now_AB_A);  // (14)
       // Torque errors are relative to the torque scale k_T |i| |psi| (the value for orthogonal
       // vectors): a random draw can make the torque itself almost zero.
       const double torque_scale =
           coefficients.torque_per_flux_A * d.i_now_AB_A.norm() * flux_now.norm();
-      worst_torque = std::max(worst_torque, std::abs(torque_now - plant.torque_Nm()) / torque_scale);
+      worst_torque =
+          std::max(worst_torque, std::abs(torque_now - plant.torque_Nm()) / torque_scale);
       for (int slice = 1; slice <= kSlices; ++slice) {
         plant.step_current_fed(d.i_now_AB_A, d.load_Nm);
         // Inside the period the torque decays as tau_k e^{-eta (t - t_k)}.
-        const double expected = torque_now * std::exp(-coefficients.eta_per_s * kT0_s * slice / kSlices);
-        worst_torque = std::max(worst_torque, std::abs(plant.torque_Nm() - expected) / torque_scale);
+        const double expected =
+            torque_now * std::exp(-coefficients.eta_per_s * kT0_s * slice / kSlices);
+        worst_torque =
+            std::max(worst_torque, std::abs(plant.torque_Nm() - expected) / torque_scale);
       }
       const Vec2<double> flux_next = stator_flux_AB(m, plant.state(), d.i_next_AB_A);
       const Vec2<double> predicted = model.next_stator_flux(flux_now, d.i_now_AB_A, d.i_next_AB_A);
@@ -120,7 +126,8 @@ TEST(ExactModel001, CoefficientsAreContinuousWhereTheFormulasDivideByZero) {
   const auto near = discretize_seed001(m, kT0_s);
   EXPECT_NEAR(near.torque_to_speed, limit, 1e-9 * limit);
   m.friction_Nms = 1e-300;
-  EXPECT_NEAR(discretize_seed001(m, kT0_s).load_to_speed, -kT0_s / m.J_kgm2, 1e-15 * kT0_s / m.J_kgm2);
+  EXPECT_NEAR(discretize_seed001(m, kT0_s).load_to_speed, -kT0_s / m.J_kgm2,
+              1e-15 * kT0_s / m.J_kgm2);
 }
 
 }  // namespace

@@ -108,8 +108,7 @@ TEST(MotorFile, SyntaxErrorNamesFileLineAndColumn) {
     load_motor_file(path);
     FAIL() << "no error";
   } catch (const ConfigError& error) {
-    EXPECT_TRUE(std::string(error.what()).starts_with(path.string() + ":2:"))
-        << error.what();
+    EXPECT_TRUE(std::string(error.what()).starts_with(path.string() + ":2:")) << error.what();
     EXPECT_NE(std::string(error.what()).find("TOML syntax error"), std::string::npos);
   }
 }

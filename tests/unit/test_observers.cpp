@@ -111,7 +111,9 @@ TEST(EncoderObserver, TracksSpeedAndLoadFromAQuantizedAngle) {
   for (int k = 0; k < 2000; ++k) {
     const Vec2<double> i = x.i_s_AB_A, flux = x.flux_r_AB_Wb;
     x = model.predict(x, v, load_Nm);
-    const double measured = std::floor(std::fmod(x.theta_mech_rad, 2 * std::numbers::pi) * counts_per_rad) / counts_per_rad;
+    const double measured =
+        std::floor(std::fmod(x.theta_mech_rad, 2 * std::numbers::pi) * counts_per_rad) /
+        counts_per_rad;
     observer.update(i, flux, v, measured);
   }
   // Quantization of 7.7e-4 rad is the only error source; a 400 rad/s observer turns a

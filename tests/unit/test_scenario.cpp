@@ -34,7 +34,8 @@ TEST(Scenario, ShippedScenariosLoad) {
   EXPECT_EQ(paper.speed.amplitude_rad_s, 100.0);
   EXPECT_EQ(paper.inner_feedback, InnerFeedback::ideal_analog);
   EXPECT_TRUE(std::isinf(paper.i_max_A));
-  const Scenario realistic = load_scenario(test::source_path("hal_sim/scenarios/seed000_realistic.toml"));
+  const Scenario realistic =
+      load_scenario(test::source_path("hal_sim/scenarios/seed000_realistic.toml"));
   EXPECT_EQ(realistic.i_max_A, 6.0);
   EXPECT_EQ(realistic.encoder_cpr, 8192u);
   EXPECT_EQ(realistic.pwm_latency_ticks, 1);
@@ -66,15 +67,18 @@ TEST(Scenario, BadInputNamesTheKey) {
       {{"drive.speed_reaching_pole=1"}, "drive.speed_reaching_pole: = 1: must be in [0, 1)"},
       {{"metrics.settle_s=9"}, "metrics.settle_s: = 9: must be below simulation.duration_s"},
       {{"reference.speed.kind=steps"}, "reference.speed.times_s: missing key"},
-      {{"inverter.v_bus_V=600"}, "inverter.v_bus_V: = 600: must be below sensors.adc_bus_full_scale_V"},
+      {{"inverter.v_bus_V=600"},
+       "inverter.v_bus_V: = 600: must be below sensors.adc_bus_full_scale_V"},
       {{"duration_s"}, "--set duration_s: expected table.key=VALUE"},
       {{"=3"}, "--set =3: expected table.key=VALUE"},
       {{"simulation.duration_s=inf"}, "simulation.duration_s: = inf: must be finite"},
       {{"load.high_Nm=nan"}, "load.high_Nm: = nan: must be finite"},
       {{"sensors.adc_bus_full_scale_V=inf"}, "sensors.adc_bus_full_scale_V: = inf: must be finite"},
       {{"drive.sample_period_s=1e-9"}, "drive.sample_period_s: = 1e-09: must be in [1e-6, 1e-2] s"},
-      {{"reference.flux.flux2_Wb2=5e-4"}, "reference.flux.flux2_Wb2: = 0.0005: must be > 0.002 Wb^2"},
-      {{"sensors.ideal=false", "observers.section_iv=true"}, "observers.section_iv: needs sensors.ideal = true"},
+      {{"reference.flux.flux2_Wb2=5e-4"},
+       "reference.flux.flux2_Wb2: = 0.0005: must be > 0.002 Wb^2"},
+      {{"sensors.ideal=false", "observers.section_iv=true"},
+       "observers.section_iv: needs sensors.ideal = true"},
       {{"inverter.i_max_A=-inf"}, "inverter.i_max_A: = -inf: must be finite"},
   };
   for (const Case& c : cases) {
@@ -84,11 +88,13 @@ TEST(Scenario, BadInputNamesTheKey) {
 }
 
 TEST(Scenario, MotorFileAndMotorTableTogetherAreRejected) {
-  const auto directory = std::filesystem::temp_directory_path() / ("imd_test_scenario_" + std::to_string(::getpid()));
+  const auto directory =
+      std::filesystem::temp_directory_path() / ("imd_test_scenario_" + std::to_string(::getpid()));
   std::filesystem::create_directories(directory);
   const auto path = directory / "both.toml";
   std::ofstream(path) << "motor_file = \"x.toml\"\n[motor]\nRs_Ohm = 1.0\n";
-  EXPECT_NE(error_of(path.string(), {}).find("give either motor_file or [motor], not both"), std::string::npos);
+  EXPECT_NE(error_of(path.string(), {}).find("give either motor_file or [motor], not both"),
+            std::string::npos);
   std::ofstream(path) << "motor_file = \"missing.toml\"\n";
   EXPECT_NE(error_of(path.string(), {}).find("missing.toml: cannot open file"), std::string::npos);
 }

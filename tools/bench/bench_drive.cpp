@@ -26,12 +26,16 @@ void BM_Scenario(benchmark::State& bench, const char* name, const char* precisio
     benchmark::DoNotOptimize(r);
   }
   // One iteration simulates 1 s.
-  bench.counters["sim_s_per_wall_s"] = benchmark::Counter(double(bench.iterations()), benchmark::Counter::kIsRate);
+  bench.counters["sim_s_per_wall_s"] =
+      benchmark::Counter(double(bench.iterations()), benchmark::Counter::kIsRate);
   bench.counters["tick_exec_ns_mean"] = exec_ns;
 }
-BENCHMARK_CAPTURE(BM_Scenario, paper_double, "seed000_paper.toml", "double")->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(BM_Scenario, realistic_double, "seed000_realistic.toml", "double")->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(BM_Scenario, realistic_float, "seed000_realistic.toml", "float")->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_Scenario, paper_double, "seed000_paper.toml", "double")
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_Scenario, realistic_double, "seed000_realistic.toml", "double")
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_Scenario, realistic_float, "seed000_realistic.toml", "float")
+    ->Unit(benchmark::kMillisecond);
 
 /// The realistic drive, brought to the running state on the board, then ticked in place.
 template <typename T>
@@ -47,11 +51,11 @@ void BM_TickOnly(benchmark::State& bench) {
   imd::firmware::DriveConfig config;
   config.i_max_A = 6.0;
   config.speed_reaching_pole = config.flux_reaching_pole = 0.98;
-  imd::firmware::Drive<T> drive(s.motor, config,
-                                {board.pwm(), board.encoder(), board.adc(), board.timer()},
-                                references);
+  imd::firmware::Drive<T> drive(
+      s.motor, config, {board.pwm(), board.encoder(), board.adc(), board.timer()}, references);
   board.timer().start(drive);
-  for (int k = 0; k < 5000 && drive.state() != imd::firmware::DriveState::running; ++k) board.run_tick();
+  for (int k = 0; k < 5000 && drive.state() != imd::firmware::DriveState::running; ++k)
+    board.run_tick();
   for (int k = 0; k < 2000; ++k) board.run_tick();
   if (drive.state() != imd::firmware::DriveState::running) bench.SkipWithError("drive not running");
   for (auto _ : bench) drive.on_tick();

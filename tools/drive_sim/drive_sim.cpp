@@ -5,8 +5,8 @@
 //
 // Prints the summary (JSON) on standard output. Exit codes: 0 success, 2 bad input (command
 // line or scenario file), 1 an output could not be written.
-#include <CLI/CLI.hpp>
 #include <fmt/format.h>
+#include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
 #include <cmath>
@@ -15,8 +15,8 @@
 #include <filesystem>
 #include <iostream>
 #include <optional>
-#include <system_error>
 #include <string>
+#include <system_error>
 #include <vector>
 
 #include <spawn.h>
@@ -42,7 +42,8 @@ constexpr const char* kCsvHeader =
 
 nlohmann::ordered_json summary_json(const imd::sim::Scenario& s, const imd::sim::Summary& r) {
   nlohmann::ordered_json faults = nlohmann::ordered_json::array();
-  for (const auto& f : r.faults) faults.push_back({{"code", f.code}, {"detected_at_s", f.detected_at_s}});
+  for (const auto& f : r.faults)
+    faults.push_back({{"code", f.code}, {"detected_at_s", f.detected_at_s}});
   return {{"scenario", s.source},
           {"precision", s.precision},
           {"settle_s", s.settle_s},
@@ -53,7 +54,8 @@ nlohmann::ordered_json summary_json(const imd::sim::Scenario& s, const imd::sim:
           {"load_est_rms_err_Nm", r.load_est_rms_err_Nm},
           {"i_peak_A", r.i_peak_A},
           {"i_peak_total_A", r.i_peak_total_A},
-          {"i_max_A", std::isfinite(s.i_max_A) ? nlohmann::ordered_json(s.i_max_A) : nlohmann::ordered_json(nullptr)},
+          {"i_max_A", std::isfinite(s.i_max_A) ? nlohmann::ordered_json(s.i_max_A)
+                                               : nlohmann::ordered_json(nullptr)},
           {"saturated_fraction", r.saturated_fraction},
           {"running_from_s", r.running_from_s},
           {"ticks", r.ticks},
@@ -93,7 +95,8 @@ int main(int argc, char** argv) {
       ->check(CLI::PositiveNumber);
   app.add_option("--csv", csv_path, "Write one row per tick to this CSV file");
   app.add_option("--summary-json", summary_path, "Write the summary to this JSON file");
-  app.add_option("--plot", plot_path, "Write the paper's Figures 1-5 to this PNG (needs python3-matplotlib)");
+  app.add_option("--plot", plot_path,
+                 "Write the paper's Figures 1-5 to this PNG (needs python3-matplotlib)");
   app.add_option("--set", overrides, "Override a scenario key: table.key=VALUE (repeatable)");
   try {
     app.parse(argc, argv);
@@ -113,7 +116,10 @@ int main(int argc, char** argv) {
 
   // The plot is drawn from the CSV; without --csv a temporary file serves.
   const bool temporary_csv = csv_path.empty() && !plot_path.empty();
-  if (temporary_csv) csv_path = (std::filesystem::temp_directory_path() / fmt::format("drive_sim_{}.csv", ::getpid())).string();
+  if (temporary_csv)
+    csv_path =
+        (std::filesystem::temp_directory_path() / fmt::format("drive_sim_{}.csv", ::getpid()))
+            .string();
   std::FILE* csv = nullptr;
   if (!csv_path.empty()) {
     csv = std::fopen(csv_path.c_str(), "w");
@@ -127,14 +133,15 @@ int main(int argc, char** argv) {
   imd::sim::RunCallbacks callbacks;
   if (csv != nullptr) {
     callbacks.row = [&](const imd::sim::SimRow& r) {
-      fmt::print(csv,
-                 "{:.6f},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.6g},{:.6g},{:.6g},{:.6g},"
-                 "{:.6g},{:.6g},{:.8g},{:.8g},{:.8g},{:.8g},{:.8g},{:.8g},{:.8g},{:.8g},{:.6g},{},{}\n",
-                 r.t_s, r.omega_mech_rad_s, r.omega_ref_rad_s, r.omega_est_rad_s, r.flux2_Wb2,
-                 r.flux2_ref_Wb2, r.flux2_est_Wb2, r.load_Nm, r.load_est_Nm, r.i_alpha_A, r.i_beta_A,
-                 r.v_alpha_V, r.v_beta_V, r.discriminant, r.c_k, r.flux_A_Wb, r.flux_B_Wb,
-                 r.flux_A_est_Wb, r.flux_B_est_Wb, r.theta_mech_rad, r.theta_est_rad, r.torque_Nm,
-                 r.state, r.saturated ? 1 : 0);
+      fmt::print(
+          csv,
+          "{:.6f},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.6g},{:.6g},{:.6g},{:.6g},"
+          "{:.6g},{:.6g},{:.8g},{:.8g},{:.8g},{:.8g},{:.8g},{:.8g},{:.8g},{:.8g},{:.6g},{},{}\n",
+          r.t_s, r.omega_mech_rad_s, r.omega_ref_rad_s, r.omega_est_rad_s, r.flux2_Wb2,
+          r.flux2_ref_Wb2, r.flux2_est_Wb2, r.load_Nm, r.load_est_Nm, r.i_alpha_A, r.i_beta_A,
+          r.v_alpha_V, r.v_beta_V, r.discriminant, r.c_k, r.flux_A_Wb, r.flux_B_Wb, r.flux_A_est_Wb,
+          r.flux_B_est_Wb, r.theta_mech_rad, r.theta_est_rad, r.torque_Nm, r.state,
+          r.saturated ? 1 : 0);
     };
   }
   callbacks.progress = [&](double simulated_s, double wall_s) {

@@ -27,11 +27,12 @@ class PlantOracle final : public firmware::StateOracle {
   explicit PlantOracle(const SimBoard& board) : board_(board) {}
   firmware::TrueState true_state() const noexcept override {
     const PlantState& s = board_.plant().state();
-    const auto rotor = control::Rotation<double>::from_angle(board_.plant().pole_pairs() * s.theta_mech_rad);
+    const auto rotor =
+        control::Rotation<double>::from_angle(board_.plant().pole_pairs() * s.theta_mech_rad);
     const Vec2 flux = rotor.apply_inverse(s.flux_r_alphabeta_Wb);
     const Vec2 current = rotor.apply_inverse(s.i_s_alphabeta_A);
-    return {flux.x(), flux.y(), current.x(), current.y(), s.omega_mech_rad_s, s.theta_mech_rad,
-            board_.load_Nm()};
+    return {flux.x(),           flux.y(),         current.x(),     current.y(),
+            s.omega_mech_rad_s, s.theta_mech_rad, board_.load_Nm()};
   }
 
  private:
@@ -79,17 +80,18 @@ Summary run(const Scenario& s, const RunCallbacks& callbacks) {
   {  // at rest at initial_theta; magnetized (Phi = Lm I, along A) if initial_flux2 > 0
     PlantState start;
     start.theta_mech_rad = s.initial_theta_mech_rad;
-    const auto rotor = control::Rotation<double>::from_angle(s.motor.pole_pairs * s.initial_theta_mech_rad);
+    const auto rotor =
+        control::Rotation<double>::from_angle(s.motor.pole_pairs * s.initial_theta_mech_rad);
     start.flux_r_alphabeta_Wb = rotor.apply(Vec2(std::sqrt(s.initial_flux2_Wb2), 0.0));
     start.i_s_alphabeta_A = rotor.apply(Vec2(std::sqrt(s.initial_flux2_Wb2) / s.motor.Lm_H, 0.0));
     board.plant().set_state(start);
   }
   const ScenarioReferences references(s);
   const PlantOracle oracle(board);
-  firmware::Drive<T> drive(s.motor, drive_config(s),
-                           {board.pwm(), board.encoder(), board.adc(), board.timer(),
-                            &board.analog_inner_loop()},
-                           references, s.ideal_sensors ? &oracle : nullptr);
+  firmware::Drive<T> drive(
+      s.motor, drive_config(s),
+      {board.pwm(), board.encoder(), board.adc(), board.timer(), &board.analog_inner_loop()},
+      references, s.ideal_sensors ? &oracle : nullptr);
   board.timer().start(drive);
 
   Summary summary;
@@ -144,7 +146,8 @@ Summary run(const Scenario& s, const RunCallbacks& callbacks) {
 
     const double current_A = truth.i_s_alphabeta_A.norm();
     summary.i_peak_total_A = std::max(summary.i_peak_total_A, current_A);
-    if (summary.running_from_s < 0 && rec.state == firmware::DriveState::running) summary.running_from_s = t_s;
+    if (summary.running_from_s < 0 && rec.state == firmware::DriveState::running)
+      summary.running_from_s = t_s;
     if (rec.fault != last_fault) {
       summary.faults.push_back({firmware::fault_name(rec.fault), t_s});
       last_fault = rec.fault;
@@ -170,9 +173,11 @@ Summary run(const Scenario& s, const RunCallbacks& callbacks) {
       }
     }
   }
-  if (summary.faults.empty() || summary.faults.back().code != "plant_diverged") summary.ticks = ticks;
+  if (summary.faults.empty() || summary.faults.back().code != "plant_diverged")
+    summary.ticks = ticks;
   summary.simulated_s = double(summary.ticks) * s.sample_period_s;
-  summary.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+  summary.wall_time_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
   // Nothing after settle_s (a run that ended early): the metrics are not defined (null in JSON).
   const double n = measured > 0 ? double(measured) : std::nan("");
   summary.speed_rms_err_rad_s = std::sqrt(speed_sq / n);
