@@ -198,10 +198,9 @@ void Drive<T>::on_tick() noexcept {
     control::RotorFrameState<T> x = e.x;
     if (latency) x = model_.predict(e.x, v_in_flight_V_, e.load_Nm);
     x.theta_mech_rad = control::wrap_pi(x.theta_mech_rad);
-    // References at x's step and the step after, the speed through the ramp (which follows
-    // the estimate until the drive runs).
-    // Without a ramp limit the law sees the reference itself, so that the reaching law acts on
-    // the real error from the first running tick.
+    // References at x's step (ref_now) and the step after (ref), the speed through the ramp.
+    // Until the drive runs, a limited ramp follows the estimate and an unlimited one the
+    // reference, so that the reaching law acts on the real error from the first running tick.
     if (state_ != DriveState::running) {
       speed_ramp_.reset(speed_ramp_.limited() ? e.x.omega_mech_rad_s
                                               : T(references_.at_tick(k).omega_mech_rad_s));
