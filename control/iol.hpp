@@ -1,0 +1,130 @@
+#pragma once
+/// Input-output linearizing control of torque and stator flux for the current-fed motor,
+/// paper 001, Section 4. With x = (phi_sA, phi_sB, i_A, i_B) at t_k (the current held over the
+/// period) and u = i(t_{k+1}), the outputs (20) obey (22)-(23):
+///   y1(k+1) = b11 u1 + b12 u2,        (torque, k_T = 3/2 included: amplitude-invariant Clarke)
+///   y2(k+1) = a + b21 u1 + b22 u2,    (the modified squared stator flux)
+/// with phi_r = e^{-eta T0} phi_s + ls (1 - sigma - e^{-eta T0}) i (the paper's phi-bar_r),
+/// a = ls (1 - sigma - e^{-eta T0}) phi_s^T i, B = [[-k n_p phi_r2, k n_p phi_r1],
+/// [ls sigma phi_s1, ls sigma phi_s2]] and det B = -k n_p ls sigma phi_s^T phi_r (26). The law
+/// (24) u = B^-1 [v1; v2 - a] gives y1(k+1) = v1, y2(k+1) = v2 (25).
+///
+/// Determinant guard (docs/iol.md): B must stay invertible with det B < 0, i.e. the stator flux
+/// and phi_r must not become orthogonal. Following the paper's suggestion the torque command
+/// v1 is saturated dynamically: the largest |v1| <= |v1_ref| is used for which the exactly
+/// predicted fluxes of step k+1 stay within max_angle of each other. A state whose own B_k is
+/// (nearly) singular is refused: the current is held. Tick context; no division by zero.
+#include <cmath>
+
+#include "control/exact_model_001.hpp"
+#include "control/frames.hpp"
+
+namespace imd::control {
+
+struct IolConfig {
+  /// Largest angle between the stator flux and phi_r at step k+1: det B(k+1) stays below
+  /// -cos(max_angle) of its value for aligned vectors (cos 60 deg = 0.5).
+  double max_angle_rad = 1.0471975511965976;
+  /// B_k is refused when the angle at step k exceeds this (det within cos of zero) or the
+  /// stator flux is below min_flux_Wb.
+  double refuse_angle_rad = 1.5184364492350666;  // 87 degrees
+  double min_flux_Wb = 1e-3;
+};
+
+enum class IolStatus { ok, singular };
+
+template <typename T>
+struct IolInput {
+  Vec2<T> flux_s_AB_Wb = Vec2<T>::Zero();  ///< x1, x2 at t_k
+  Vec2<T> i_s_AB_A = Vec2<T>::Zero();      ///< x3, x4: the current held over [t_k, t_{k+1})
+  T torque_ref_Nm = T(0);                  ///< v1, the torque wanted at t_{k+1}
+  T y2_ref = T(0);                         ///< v2, the second output wanted at t_{k+1} (Wb^2)
+};
+
+template <typename T>
+struct IolOutput {
+  IolStatus status = IolStatus::singular;
+  Vec2<T> i_next_AB_A = Vec2<T>::Zero();  ///< u = i(t_{k+1}): the current for the next period
+  T torque_cmd_Nm = T(0);                 ///< v1 after the guard
+  bool torque_limited = false;
+  T det_B = T(0);       ///< det B_k
+  T det_B_next = T(0);  ///< predicted det B_{k+1}
+};
+
+template <typename T>
+class Iol {
+ public:
+  Iol(const ExactModel001Coefficients& c, const IolConfig& config) noexcept
+      : e_(T(c.flux_decay)),
+        c_(T(c.flux_from_i_now_H)),
+        ls_sigma_(T(c.flux_from_i_next_H)),
+        k_np_(T(c.torque_per_flux_A)),
+        cos_max_(T(std::cos(config.max_angle_rad))),
+        cos_refuse_(T(std::cos(config.refuse_angle_rad))),
+        min_flux_(T(config.min_flux_Wb)) {}
+
+  /// The paper's phi-bar_r(k) = e^{-eta T0} phi_s + ls (1 - sigma - e^{-eta T0}) i.
+  Vec2<T> modified_rotor_flux(const Vec2<T>& flux_s, const Vec2<T>& i) const noexcept {
+    return e_ * flux_s + c_ * i;
+  }
+
+  /// y2(k) of (20) from the stator fluxes of steps k and k-1.
+  T y2(const Vec2<T>& flux_s_now, const Vec2<T>& flux_s_before) const noexcept {
+    return flux_s_now.dot(flux_s_before) - e_ * flux_s_before.squaredNorm();
+  }
+
+  IolOutput<T> step(const IolInput<T>& in) const noexcept {
+    IolOutput<T> out;
+    out.i_next_AB_A = in.i_s_AB_A;  // refused: hold the current
+    const Vec2<T>& flux = in.flux_s_AB_Wb;
+    const Vec2<T> flux_r = modified_rotor_flux(flux, in.i_s_AB_A);
+    out.det_B = -k_np_ * ls_sigma_ * flux.dot(flux_r);
+    if (!aligned_enough(flux, flux_r, cos_refuse_) || !(flux.norm() >= min_flux_)) return out;
+    out.status = IolStatus::ok;
+
+    const T a = c_ * flux.dot(in.i_s_AB_A);
+    const auto law = [&](T v1) {  // (24): u = B^-1 [v1; v2 - a]
+      const T w2 = in.y2_ref - a;
+      // B^-1 = [[b22, -b12], [-b21, b11]] / det
+      const T b11 = -k_np_ * flux_r.y(), b12 = k_np_ * flux_r.x();
+      const T b21 = ls_sigma_ * flux.x(), b22 = ls_sigma_ * flux.y();
+      return Vec2<T>((b22 * v1 - b12 * w2) / out.det_B, (-b21 * v1 + b11 * w2) / out.det_B);
+    };
+    const auto next_fluxes_ok = [&](const Vec2<T>& u, T* det_next) {
+      const Vec2<T> flux_next = e_ * flux + c_ * in.i_s_AB_A + ls_sigma_ * u;  // (19)
+      const Vec2<T> flux_r_next = modified_rotor_flux(flux_next, u);
+      *det_next = -k_np_ * ls_sigma_ * flux_next.dot(flux_r_next);
+      return aligned_enough(flux_next, flux_r_next, cos_max_);
+    };
+
+    Vec2<T> u = law(in.torque_ref_Nm);
+    out.torque_cmd_Nm = in.torque_ref_Nm;
+    if (!next_fluxes_ok(u, &out.det_B_next)) {
+      // Largest fraction s of v1_ref that keeps the guard (bisection; s = 0 is the flux-only
+      // command, which keeps the fluxes as aligned as the flux command allows).
+      T low = T(0), high = T(1);
+      for (int i = 0; i < 30; ++i) {
+        const T mid = (low + high) / T(2);
+        T ignored;
+        (next_fluxes_ok(law(mid * in.torque_ref_Nm), &ignored) ? low : high) = mid;
+      }
+      out.torque_cmd_Nm = low * in.torque_ref_Nm;
+      out.torque_limited = true;
+      u = law(out.torque_cmd_Nm);
+      next_fluxes_ok(u, &out.det_B_next);
+    }
+    out.i_next_AB_A = u;
+    return out;
+  }
+
+ private:
+  /// a . b >= cos_limit |a| |b|, false for NaN.
+  static bool aligned_enough(const Vec2<T>& a, const Vec2<T>& b, T cos_limit) noexcept {
+    return a.dot(b) >= cos_limit * a.norm() * b.norm() && a.dot(b) > T(0);
+  }
+
+  T e_, c_, ls_sigma_, k_np_;
+  T cos_max_, cos_refuse_, min_flux_;
+};
+
+}  // namespace imd::control
