@@ -1,0 +1,48 @@
+#pragma once
+/// Outer loop of the stator flux (paper 001, Fig. 5). The input-output linearization makes
+/// y2(k+1) = v2(k), and y2(k) ~ F(k) - e F(k-1) with F = |phi_s|^2 and e = e^{-eta T0} (the
+/// paper's design assumption), so from v2 to F the loop sees F(k+1) = e F(k) + v2(k): a pole at
+/// e, close to 1 (0.998 for the 37 kW motor at 1 ms). The loop adds to the feed-forward
+/// (1 - e) F_ref of (21) a PI on F_ref - F:
+///   v2 = (1 - e) F_ref + Kp err + I,   I <- I + Ki err.
+/// The closed loop (F, I) has the characteristic polynomial z^2 - (1 + e - Kp) z + (e - Kp + Ki);
+/// a double pole at z_f = exp(-T0 / tau) gives Kp = 1 + e - 2 z_f and Ki = (1 - z_f)^2. The
+/// integrator removes what (21) leaves: y2 = F (cos(w_slip T0) - e) in steady state.
+/// Tick context except the constructor.
+#include <cmath>
+
+namespace imd::control {
+
+struct FluxOuterLoopGains {
+  double kp = 0.0;
+  double ki = 0.0;
+};
+
+/// Gains for a double closed-loop pole at exp(-T0 / time_constant_s).
+inline FluxOuterLoopGains place_flux_outer_loop(double flux_decay, double T0_s,
+                                                double time_constant_s) {
+  const double z = std::exp(-T0_s / time_constant_s);
+  return {1.0 + flux_decay - 2.0 * z, (1.0 - z) * (1.0 - z)};
+}
+
+template <typename T>
+class FluxOuterLoop {
+ public:
+  FluxOuterLoop(double flux_decay, const FluxOuterLoopGains& gains) noexcept
+      : e_(T(flux_decay)), kp_(T(gains.kp)), ki_(T(gains.ki)) {}
+
+  /// v2 for the next step from the squared stator-flux reference and measurement (Wb^2).
+  T step(T flux2_ref_Wb2, T flux2_Wb2) noexcept {
+    const T error = flux2_ref_Wb2 - flux2_Wb2;
+    const T v2 = (T(1) - e_) * flux2_ref_Wb2 + kp_ * error + integral_;
+    integral_ += ki_ * error;
+    return v2;
+  }
+  void reset() noexcept { integral_ = T(0); }
+
+ private:
+  T e_, kp_, ki_;
+  T integral_ = T(0);
+};
+
+}  // namespace imd::control

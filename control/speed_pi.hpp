@@ -1,0 +1,52 @@
+#pragma once
+/// Discrete PI speed controller producing a torque reference, with a torque limit and
+/// anti-windup by conditional integration: the integrator does not grow while the output is
+/// saturated in the direction the error pushes. Tick context except the constructor.
+#include <algorithm>
+
+namespace imd::control {
+
+struct SpeedPiConfig {
+  double kp_Nm_per_rad_s = 0.0;  ///< proportional gain
+  double ki_Nm_per_rad = 0.0;    ///< integral gain (per second of integrated error)
+  double torque_limit_Nm = 0.0;  ///< |output| <= this
+  double period_s = 1e-3;
+};
+
+/// Gains for a speed loop of bandwidth w_c on inertia J (Kp = J w_c, integral time 4 / w_c,
+/// which keeps the integral zero a decade-ish below the crossover).
+inline SpeedPiConfig design_speed_pi(double J_kgm2, double bandwidth_rad_s, double torque_limit_Nm,
+                                     double period_s) {
+  const double kp = J_kgm2 * bandwidth_rad_s;
+  return {kp, kp * bandwidth_rad_s / 4.0, torque_limit_Nm, period_s};
+}
+
+template <typename T>
+class SpeedPi {
+ public:
+  explicit SpeedPi(const SpeedPiConfig& c) noexcept
+      : kp_(T(c.kp_Nm_per_rad_s)),
+        ki_T0_(T(c.ki_Nm_per_rad * c.period_s)),
+        limit_(T(c.torque_limit_Nm)) {}
+
+  /// Torque reference from the speed error. Returns a value within +-limit.
+  T step(T omega_ref_rad_s, T omega_rad_s) noexcept {
+    const T error = omega_ref_rad_s - omega_rad_s;
+    const T unclamped = kp_ * error + integral_;
+    const T output = std::clamp(unclamped, -limit_, limit_);
+    const bool pushing_further =
+        (unclamped > limit_ && error > T(0)) || (unclamped < -limit_ && error < T(0));
+    if (!pushing_further) integral_ = std::clamp(integral_ + ki_T0_ * error, -limit_, limit_);
+    saturated_ = output != unclamped;
+    return output;
+  }
+  bool saturated() const noexcept { return saturated_; }
+  void reset(T integral_Nm = T(0)) noexcept { integral_ = integral_Nm; }
+
+ private:
+  T kp_, ki_T0_, limit_;
+  T integral_ = T(0);
+  bool saturated_ = false;
+};
+
+}  // namespace imd::control
