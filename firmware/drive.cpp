@@ -254,7 +254,7 @@ void Drive<T>::on_tick() noexcept {
     if (config_.analog_inner_loop) {
       if (!finite(v)) trip(FaultCode::non_finite);
       if (state_ != DriveState::fault && hw_.analog_inner_loop != nullptr) {
-        hw_.analog_inner_loop->set_input_AB_V(float(v.x()), float(v.y()));
+        hw_.analog_inner_loop->set_input_AB_V(double(v.x()), double(v.y()));
         hw_.pwm.enable();
       }
     } else {

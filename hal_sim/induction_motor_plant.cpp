@@ -35,9 +35,8 @@ double InductionMotorPlant::torque_Nm(const Vec2& i_s_A, const Vec2& flux_r_Wb) 
   return k_.mu_per_kgm2 * motor_.J_kgm2 * control::dot_J(i_s_A, flux_r_Wb);
 }
 
-Vec2 InductionMotorPlant::flux_s_alphabeta_Wb() const noexcept {
-  return k_.sigma_H * state_.i_s_alphabeta_A +
-         motor_.Lm_H / motor_.Lr_H * state_.flux_r_alphabeta_Wb;
+Vec2 InductionMotorPlant::flux_s_alphabeta_Wb(const Vec2& i_s_alphabeta_A) const noexcept {
+  return k_.sigma_H * i_s_alphabeta_A + motor_.Lm_H / motor_.Lr_H * state_.flux_r_alphabeta_Wb;
 }
 
 StateVector InductionMotorPlant::voltage_fed_derivative(const StateVector& x, const Vec2& u,

@@ -66,8 +66,10 @@ class InductionMotorPlant {
   /// 3/2 p (Lm/Lr) I^T J Phi for a current and rotor flux in the same frame.
   double torque_Nm(const Vec2& i_s_A, const Vec2& flux_r_Wb) const noexcept;
 
-  /// Stator flux sigma I + (Lm/Lr) Phi of the present state (stationary frame).
-  Vec2 flux_s_alphabeta_Wb() const noexcept;
+  /// Stator flux sigma I + (Lm/Lr) Phi of the present state (stationary frame), or with the
+  /// present rotor flux and another stator current (a current-fed step).
+  Vec2 flux_s_alphabeta_Wb() const noexcept { return flux_s_alphabeta_Wb(state_.i_s_alphabeta_A); }
+  Vec2 flux_s_alphabeta_Wb(const Vec2& i_s_alphabeta_A) const noexcept;
 
   /// dx/dt of model (1) for stator voltage u and load torque. Exposed for benchmarks.
   StateVector voltage_fed_derivative(const StateVector& x, const Vec2& u_s_alphabeta_V,

@@ -28,13 +28,29 @@ void SimBoard::run_tick() {
   const double load_now_Nm = load_Nm();
   // What the firmware wrote this tick acts now (no latency) or from the next tick.
   const Vec2 written_analog(analog_.v_A_V(), analog_.v_B_V());
+  const Vec2 written_current(current_source_.i_A_A(), current_source_.i_B_A());
   if (config_.pwm_latency_ticks == 0) {
     active_duty_ = pwm_.written();
     active_analog_input_V_ = written_analog;
+    active_current_AB_A_ = written_current;
   }
+  const PlantState& now = plant_.state();
+  Vec2 current_now = now.i_s_alphabeta_A;  // continuous unless a current source steps it
+  if (!pwm_.enabled()) {
+    current_now.setZero();
+  } else if (config_.current_source) {
+    current_now = control::Rotation<double>::from_angle(plant_.pole_pairs() * now.theta_mech_rad)
+                      .apply(active_current_AB_A_);
+  }
+  start_torque_Nm_ = plant_.torque_Nm(current_now, now.flux_r_alphabeta_Wb);
+  start_flux_s_alphabeta_Wb_ = plant_.flux_s_alphabeta_Wb(current_now);
+
   if (!pwm_.enabled()) {
     applied_voltage_V_.setZero();
     plant_.step_current_fed(Vec2::Zero(), load_now_Nm);
+  } else if (config_.current_source) {
+    applied_voltage_V_.setZero();  // not defined for an ideal current source
+    plant_.step_current_fed(active_current_AB_A_, load_now_Nm);
   } else if (config_.inner_feedback == InnerFeedback::ideal_analog) {
     applied_voltage_V_ = plant_.analog_feedback_voltage_V(active_analog_input_V_);
     plant_.step_analog_feedback(active_analog_input_V_, load_now_Nm);
@@ -45,6 +61,7 @@ void SimBoard::run_tick() {
   if (config_.pwm_latency_ticks != 0) {
     active_duty_ = pwm_.written();
     active_analog_input_V_ = written_analog;
+    active_current_AB_A_ = written_current;
   }
 }
 

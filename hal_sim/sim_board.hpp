@@ -6,7 +6,9 @@
 ///   3. the plant integrates [t_k, t_{k+1}] with what the inverter (or the analog inner-loop
 ///      device) applies: with one tick of latency, the duties written at tick k act from k+1.
 /// With the PWM disabled the inverter is off and the stator currents are zero (the free-
-/// wheeling transient, a fraction of a millisecond, is not modelled).
+/// wheeling transient, a fraction of a millisecond, is not modelled). With `current_source` the
+/// stator current is imposed by the ideal current source instead (paper 001's current-fed
+/// plant); the PWM enable still gates it.
 #include <cstdint>
 
 #include "control/motor_parameters.hpp"
@@ -27,6 +29,7 @@ struct SimBoardConfig {
   int substeps = 10;          ///< RK4 steps per period
   int pwm_latency_ticks = 1;  ///< 0 or 1
   InnerFeedback inner_feedback = InnerFeedback::digital;
+  bool current_source = false;       ///< the ideal current source drives the motor
   double v_bus_V = 311.0;
   uint32_t encoder_cpr = 8192;
   AdcModelConfig adc;
@@ -45,6 +48,7 @@ class SimBoard {
   hal::Gpio& gpio() noexcept { return gpio_; }
   hal::ControlTimer& timer() noexcept { return timer_; }
   hal::AnalogInnerLoop& analog_inner_loop() noexcept { return analog_; }
+  hal::CurrentSource& current_source() noexcept { return current_source_; }
   SimCan& can_side() noexcept { return can_; }
 
   InductionMotorPlant& plant() noexcept { return plant_; }
@@ -57,6 +61,10 @@ class SimBoard {
   /// Stator voltage the plant saw over the last period (alpha-beta); for the analog device, the
   /// value at the start of the period.
   const Vec2& applied_voltage_V() const noexcept { return applied_voltage_V_; }
+  /// Torque and stator flux at the start of the last period, with the current of that period
+  /// (after the step a current source makes at the period's start).
+  double start_torque_Nm() const noexcept { return start_torque_Nm_; }
+  const Vec2& start_flux_s_alphabeta_Wb() const noexcept { return start_flux_s_alphabeta_Wb_; }
 
   void run_tick();
 
@@ -74,8 +82,12 @@ class SimBoard {
   SimGpio gpio_;
   SimTimer timer_;
   SimAnalogInnerLoop analog_;
+  SimCurrentSource current_source_;
   hal::PhaseDuties active_duty_{0.5f, 0.5f, 0.5f};
   Vec2 active_analog_input_V_ = Vec2::Zero();
+  Vec2 active_current_AB_A_ = Vec2::Zero();
+  double start_torque_Nm_ = 0.0;
+  Vec2 start_flux_s_alphabeta_Wb_ = Vec2::Zero();
   Vec2 applied_voltage_V_ = Vec2::Zero();
 };
 

@@ -8,6 +8,7 @@
 #include "hal/can_bus.hpp"
 #include "hal/control_timer.hpp"
 #include "hal/current_adc.hpp"
+#include "hal/current_source.hpp"
 #include "hal/encoder.hpp"
 #include "hal/gpio.hpp"
 #include "hal/pwm.hpp"
@@ -103,15 +104,29 @@ class SimTimer final : public hal::ControlTimer {
 /// The paper's analog inner-feedback device; the board reads the latest input.
 class SimAnalogInnerLoop final : public hal::AnalogInnerLoop {
  public:
-  void set_input_AB_V(float v_A_V, float v_B_V) noexcept override {
+  void set_input_AB_V(double v_A_V, double v_B_V) noexcept override {
     v_A_V_ = v_A_V;
     v_B_V_ = v_B_V;
   }
-  float v_A_V() const noexcept { return v_A_V_; }
-  float v_B_V() const noexcept { return v_B_V_; }
+  double v_A_V() const noexcept { return v_A_V_; }
+  double v_B_V() const noexcept { return v_B_V_; }
 
  private:
-  float v_A_V_ = 0.0f, v_B_V_ = 0.0f;
+  double v_A_V_ = 0.0, v_B_V_ = 0.0;
+};
+
+/// The ideal current source of paper 001; the board reads the latest current.
+class SimCurrentSource final : public hal::CurrentSource {
+ public:
+  void set_current_AB_A(double i_A_A, double i_B_A) noexcept override {
+    i_A_A_ = i_A_A;
+    i_B_A_ = i_B_A;
+  }
+  double i_A_A() const noexcept { return i_A_A_; }
+  double i_B_A() const noexcept { return i_B_A_; }
+
+ private:
+  double i_A_A_ = 0.0, i_B_A_ = 0.0;
 };
 
 }  // namespace imd::sim

@@ -1,0 +1,16 @@
+#pragma once
+/// An ideal stator current source, as paper 001 assumes ("current-fed"): the current written,
+/// in the rotor-aligned frame, is imposed exactly and held there until the next write. Real
+/// boards reach the current-fed mode through an inner current loop on the PWM instead; only the
+/// simulated board provides this device, in double so that the paper's exactness can be checked
+/// to 1e-9.
+namespace imd::hal {
+
+class CurrentSource {
+ public:
+  virtual ~CurrentSource() = default;
+  /// Sets the rotor-frame stator current from the next period on. Tick context.
+  virtual void set_current_AB_A(double i_A_A, double i_B_A) noexcept = 0;
+};
+
+}  // namespace imd::hal
