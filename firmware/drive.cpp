@@ -35,12 +35,15 @@ Drive<T>::Drive(const control::MotorParameters& motor, const DriveConfig& config
       load_estimator_(coefficients_,
                       control::place_load_estimator(coefficients_, config.load_estimator_pole,
                                                     config.load_estimator_pole)),
-      speed_ramp_(config.max_accel_rad_s2, config.sample_period_s) {
+      speed_ramp_(config.max_accel_rad_s2, config.sample_period_s),
+      iol_stage_(motor, config) {
   const control::Seed000Constants k = control::derive_seed000(motor);
   sigma_H_ = T(k.sigma_H);
   beta_per_H_ = T(k.beta_per_H);
   pole_pairs_ = T(motor.pole_pairs);
   Lm_H_ = T(motor.Lm_H);
+  Ls_H_ = T(motor.Ls_H);
+  Lm_over_Lr_ = T(motor.Lm_H / motor.Lr_H);
   a21_ = T(coefficients_.a21);
   a22_ = T(coefficients_.a22);
   b2_ = T(coefficients_.b2);
@@ -156,17 +159,38 @@ control::InputDisk<T> Drive<T>::feasible_inputs(const control::RotorFrameState<T
 }
 
 template <typename T>
-control::Vec2<T> Drive<T>::magnetizing_input(const control::RotorFrameState<T>& x, T flux2_ref_Wb2,
-                                             const control::InputDisk<T>& feasible) const noexcept {
-  // Deadbeat current control along the flux (the A axis while there is none) to the current
-  // that holds the reference flux in steady state, Phi = Lm I.
+control::Vec2<T> Drive<T>::current_input(const control::RotorFrameState<T>& x,
+                                         const Vec2& i_target_AB_A,
+                                         const control::InputDisk<T>& feasible) const noexcept {
+  const Vec2 v = (i_target_AB_A - a21_ * x.flux_r_AB_Wb - a22_ * x.i_s_AB_A) / b2_;
+  return feasible.clamp(v);
+}
+
+template <typename T>
+control::Vec2<T> Drive<T>::magnetizing_current(const control::RotorFrameState<T>& x,
+                                               const Reference& ref) const noexcept {
+  // Steady state at zero slip: Phi_r = Lm I and phi_s = Ls I.
   T current_A = T(config_.magnetizing_current_A);
-  if (!(current_A > T(0))) current_A = std::sqrt(std::max(flux2_ref_Wb2, T(0))) / Lm_H_;
+  if (!(current_A > T(0))) {
+    current_A = config_.controller == ControllerKind::iol
+                    ? std::sqrt(std::max(T(ref.stator_flux2_Wb2), T(0))) / Ls_H_
+                    : std::sqrt(std::max(T(ref.flux2_Wb2), T(0))) / Lm_H_;
+  }
   if (std::isfinite(config_.i_max_A)) current_A = std::min(current_A, T(0.9 * config_.i_max_A));
   const T flux = x.flux_r_AB_Wb.norm();
   const Vec2 direction = flux > T(1e-3) ? Vec2(x.flux_r_AB_Wb / flux) : Vec2(T(1), T(0));
-  const Vec2 v = (current_A * direction - a21_ * x.flux_r_AB_Wb - a22_ * x.i_s_AB_A) / b2_;
-  return feasible.clamp(v);
+  return current_A * direction;
+}
+
+template <typename T>
+T Drive<T>::magnetized_flux2(const control::RotorFrameState<T>& x) const noexcept {
+  if (config_.controller != ControllerKind::iol) return x.flux_r_AB_Wb.squaredNorm();
+  return (sigma_H_ * x.i_s_AB_A + Lm_over_Lr_ * x.flux_r_AB_Wb).squaredNorm();
+}
+
+template <typename T>
+T Drive<T>::magnetized_flux2_ref(const Reference& ref) const noexcept {
+  return T(config_.controller == ControllerKind::iol ? ref.stator_flux2_Wb2 : ref.flux2_Wb2);
 }
 
 template <typename T>
@@ -215,18 +239,34 @@ void Drive<T>::on_tick() noexcept {
     speed_ramp_.reset(ramp_k1);
     const control::InputDisk<T> feasible = feasible_inputs(x, v_bus_V);
     Vec2 v = Vec2::Zero();
+    Vec2 i_command = Vec2::Zero();  // rotor-frame current command (magnetizing, iol)
     if (state_ == DriveState::magnetizing) {
-      const T flux2_now = e.x.flux_r_AB_Wb.squaredNorm();
-      if (flux2_now >= T(config_.magnetized_fraction * ref.flux2_Wb2)) {
+      if (magnetized_flux2(e.x) >= T(config_.magnetized_fraction) * magnetized_flux2_ref(ref)) {
         state_ = DriveState::running;
+        iol_stage_.start(magnetizing_current(x, ref));
       } else if (double(k - magnetizing_start_tick_) * config_.sample_period_s >
                  config_.magnetizing_timeout_s) {
         trip(FaultCode::magnetizing_timeout);
       } else {
-        v = magnetizing_input(x, T(ref.flux2_Wb2), feasible);
+        i_command = magnetizing_current(x, ref);
+        v = current_input(x, i_command, feasible);
       }
     }
-    if (state_ == DriveState::running) {
+    if (state_ == DriveState::running && config_.controller == ControllerKind::iol) {
+      const Reference boundary_ref = references_.at_tick(k + uint64_t(iol_stage_.ticks_per_period()));
+      const IolTickResult<T> r = iol_stage_.tick(e.x.flux_r_AB_Wb, e.x.omega_mech_rad_s, boundary_ref);
+      if (r.status != control::IolStatus::ok) trip(FaultCode::singular_control);
+      i_command = r.i_cmd_AB_A;
+      v = current_input(x, i_command, feasible);
+      if (r.boundary) {
+        record_.torque_ref_Nm = double(r.torque_ref_Nm);
+        record_.torque_cmd_Nm = double(r.torque_cmd_Nm);
+        record_.y2 = double(r.y2);
+        record_.y2_ref = double(r.y2_ref);
+        record_.stator_flux2_est_Wb2 = double(r.flux2_s_Wb2);
+        record_.torque_limited = r.torque_limited;
+      }
+    } else if (state_ == DriveState::running) {
       control::DsmcInput<T> in;
       in.flux_r_AB_Wb = x.flux_r_AB_Wb;
       in.i_s_AB_A = x.i_s_AB_A;
@@ -251,7 +291,15 @@ void Drive<T>::on_tick() noexcept {
 
     // --- inner feedback (2) and limits. The held voltage is rotated to the middle of the
     // period it acts on, where the analog law's rotation is on average.
-    if (config_.analog_inner_loop) {
+    record_.i_cmd_A_A = double(i_command.x());
+    record_.i_cmd_B_A = double(i_command.y());
+    if (config_.current_source) {
+      if (!finite(i_command)) trip(FaultCode::non_finite);
+      if (state_ != DriveState::fault && hw_.current_source != nullptr) {
+        hw_.current_source->set_current_AB_A(double(i_command.x()), double(i_command.y()));
+        hw_.pwm.enable();
+      }
+    } else if (config_.analog_inner_loop) {
       if (!finite(v)) trip(FaultCode::non_finite);
       if (state_ != DriveState::fault && hw_.analog_inner_loop != nullptr) {
         hw_.analog_inner_loop->set_input_AB_V(double(v.x()), double(v.y()));

@@ -16,6 +16,7 @@
 #include "control/motor_parameters.hpp"
 #include "firmware/drive_config.hpp"
 #include "firmware/execution_stats.hpp"
+#include "firmware/iol_stage.hpp"
 #include "firmware/reference_source.hpp"
 #include "firmware/speed_ramp.hpp"
 #include "firmware/state_oracle.hpp"
@@ -23,6 +24,7 @@
 #include "hal/analog_inner_loop.hpp"
 #include "hal/control_timer.hpp"
 #include "hal/current_adc.hpp"
+#include "hal/current_source.hpp"
 #include "hal/encoder.hpp"
 #include "hal/pwm.hpp"
 
@@ -34,6 +36,7 @@ struct DrivePeripherals {
   hal::CurrentAdc& adc;
   hal::ControlTimer& timer;
   hal::AnalogInnerLoop* analog_inner_loop = nullptr;  ///< only with config.analog_inner_loop
+  hal::CurrentSource* current_source = nullptr;        ///< only with config.current_source
 };
 
 template <typename T>
@@ -63,8 +66,16 @@ class Drive final : public hal::TickHandler {
   Estimate estimate(const hal::AdcSample& sample) noexcept;
   control::InputDisk<T> feasible_inputs(const control::RotorFrameState<T>& x,
                                         T v_bus_V) const noexcept;
-  Vec2 magnetizing_input(const control::RotorFrameState<T>& x, T flux2_ref_Wb2,
-                         const control::InputDisk<T>& feasible) const noexcept;
+  /// Deadbeat current control on the exact model: the v~ that brings I~ to the target at the
+  /// next step, clamped to the feasible inputs.
+  Vec2 current_input(const control::RotorFrameState<T>& x, const Vec2& i_target_AB_A,
+                     const control::InputDisk<T>& feasible) const noexcept;
+  /// The magnetizing current: along the flux (the A axis while there is none), of the size that
+  /// holds the reference flux in steady state (rotor flux for the DSMC, stator flux for the IOL).
+  Vec2 magnetizing_current(const control::RotorFrameState<T>& x, const Reference& ref) const noexcept;
+  /// The squared flux the start-up waits for, and its reference.
+  T magnetized_flux2(const control::RotorFrameState<T>& x) const noexcept;
+  T magnetized_flux2_ref(const Reference& ref) const noexcept;
   Vec2 compensation_AB(const control::RotorFrameState<T>& x) const noexcept;
   void trip(FaultCode code) noexcept;
 
@@ -80,7 +91,8 @@ class Drive final : public hal::TickHandler {
   control::EncoderObserver<T> encoder_observer_;
   control::LoadEstimator<T> load_estimator_;
   SpeedRamp<T> speed_ramp_;
-  T sigma_H_, beta_per_H_, pole_pairs_, Lm_H_, a21_, a22_, b2_;
+  IolStage<T> iol_stage_;
+  T sigma_H_, beta_per_H_, pole_pairs_, Lm_H_, Ls_H_, Lm_over_Lr_, a21_, a22_, b2_;
 
   DriveState state_ = DriveState::calibrating;
   FaultCode fault_ = FaultCode::none;

@@ -58,6 +58,11 @@ struct TickRecord {
   double v_A_V = 0.0, v_B_V = 0.0;         ///< v~ applied (after limiting)
   double u_alpha_V = 0.0, u_beta_V = 0.0;  ///< stator voltage command
   double discriminant = 0.0, c_k = 0.0, det_B = 0.0;
+  // The current-fed controller (iol), at its last T0 boundary.
+  double torque_ref_Nm = 0.0, torque_cmd_Nm = 0.0, y2 = 0.0, y2_ref = 0.0;
+  double stator_flux2_est_Wb2 = 0.0;
+  double i_cmd_A_A = 0.0, i_cmd_B_A = 0.0;  ///< rotor-frame current command
+  bool torque_limited = false;
   bool speed_saturated = false, flux_saturated = false, voltage_clipped = false;
   uint32_t exec_ns = 0;
 };

@@ -1,0 +1,101 @@
+#pragma once
+/// The current-fed controller of paper 001 inside the 10 kHz tick: every T0 (a whole number of
+/// ticks) the input-output linearizing law computes the rotor-frame current of the next T0
+/// period from the stator flux and the current held now; in between, the current command is
+/// held (the zero-order hold in the rotor frame that paper 001 assumes). The torque reference
+/// v1 comes from the reference or an outer speed PI; v2 from (21) or the outer flux loop.
+/// Tick context except the constructor.
+#include <cmath>
+#include <cstdint>
+
+#include "control/exact_model_001.hpp"
+#include "control/flux_outer_loop.hpp"
+#include "control/frames.hpp"
+#include "control/iol.hpp"
+#include "control/motor_parameters.hpp"
+#include "control/speed_pi.hpp"
+#include "firmware/drive_config.hpp"
+#include "firmware/reference_source.hpp"
+
+namespace imd::firmware {
+
+template <typename T>
+struct IolTickResult {
+  control::Vec2<T> i_cmd_AB_A = control::Vec2<T>::Zero();  ///< current to impose this tick
+  bool boundary = false;          ///< the law ran this tick
+  control::IolStatus status = control::IolStatus::ok;
+  T torque_ref_Nm = T(0), torque_cmd_Nm = T(0);  ///< v1 before and after the guard
+  T y2_ref = T(0), y2 = T(0);                    ///< v2, and y2(k) from the flux estimates
+  T flux2_s_Wb2 = T(0);                          ///< |phi_s|^2 at this boundary
+  bool torque_limited = false;
+};
+
+template <typename T>
+class IolStage {
+ public:
+  IolStage(const control::MotorParameters& motor, const DriveConfig& config)
+      : coefficients_(control::discretize_seed001(motor, config.iol_period_s)),
+        law_(coefficients_, control::IolConfig{}),
+        flux_loop_(coefficients_.flux_decay,
+                   control::place_flux_outer_loop(coefficients_.flux_decay, config.iol_period_s,
+                                                  config.flux_loop_time_constant_s)),
+        speed_pi_(control::design_speed_pi(motor.J_kgm2, config.speed_loop_bandwidth_rad_s,
+                                           config.torque_limit_Nm, config.iol_period_s)),
+        ticks_per_period_(static_cast<int>(std::lround(config.iol_period_s / config.sample_period_s))),
+        outer_speed_loop_(config.outer_speed_loop),
+        outer_flux_loop_(config.outer_flux_loop),
+        sigma_H_(T(motor.Ls_H - motor.Lm_H * motor.Lm_H / motor.Lr_H)),
+        Lm_over_Lr_(T(motor.Lm_H / motor.Lr_H)) {}
+
+  const control::ExactModel001Coefficients& coefficients() const noexcept { return coefficients_; }
+  int ticks_per_period() const noexcept { return ticks_per_period_; }
+
+  /// Starts the law with this current held (the magnetizing current).
+  void start(const control::Vec2<T>& i_held_AB_A) noexcept {
+    i_held_ = i_held_AB_A;
+    ticks_ = 0;
+    flux_s_before_.setZero();
+    flux_loop_.reset();
+    speed_pi_.reset();
+  }
+
+  /// One tick while running. `flux_r_AB_Wb` and `omega` are the estimates at this tick;
+  /// `ref_next` is the reference for the next T0 boundary.
+  IolTickResult<T> tick(const control::Vec2<T>& flux_r_AB_Wb, T omega_mech_rad_s,
+                        const Reference& ref_next) noexcept {
+    IolTickResult<T> r;
+    r.i_cmd_AB_A = i_held_;
+    if (ticks_++ % ticks_per_period_ != 0) return r;
+    r.boundary = true;
+    // The stator flux just after the current stepped to the held value (15).
+    const control::Vec2<T> flux_s = sigma_H_ * i_held_ + Lm_over_Lr_ * flux_r_AB_Wb;
+    r.flux2_s_Wb2 = flux_s.squaredNorm();
+    r.y2 = law_.y2(flux_s, flux_s_before_);
+    flux_s_before_ = flux_s;
+    r.torque_ref_Nm = outer_speed_loop_ ? speed_pi_.step(T(ref_next.omega_mech_rad_s), omega_mech_rad_s)
+                                        : T(ref_next.torque_Nm);
+    const T flux2_ref = T(ref_next.stator_flux2_Wb2);
+    r.y2_ref = outer_flux_loop_ ? flux_loop_.step(flux2_ref, r.flux2_s_Wb2)
+                                : (T(1) - T(coefficients_.flux_decay)) * flux2_ref;  // (21)
+    const control::IolOutput<T> out = law_.step({flux_s, i_held_, r.torque_ref_Nm, r.y2_ref});
+    r.status = out.status;
+    r.torque_cmd_Nm = out.torque_cmd_Nm;
+    r.torque_limited = out.torque_limited;
+    i_held_ = out.i_next_AB_A;  // imposed from the next boundary on, (19)
+    return r;
+  }
+
+ private:
+  control::ExactModel001Coefficients coefficients_;
+  control::Iol<T> law_;
+  control::FluxOuterLoop<T> flux_loop_;
+  control::SpeedPi<T> speed_pi_;
+  int ticks_per_period_;
+  bool outer_speed_loop_, outer_flux_loop_;
+  T sigma_H_, Lm_over_Lr_;
+  control::Vec2<T> i_held_ = control::Vec2<T>::Zero();
+  control::Vec2<T> flux_s_before_ = control::Vec2<T>::Zero();
+  uint64_t ticks_ = 0;
+};
+
+}  // namespace imd::firmware
