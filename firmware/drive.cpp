@@ -199,6 +199,7 @@ void Drive<T>::on_tick() noexcept {
   const uint64_t k = hw_.timer.tick_count();
   record_.tick = k;
   record_.speed_saturated = record_.flux_saturated = record_.voltage_clipped = false;
+  record_.iol_boundary = false;
 
   const hal::AdcSample sample = hw_.adc.sample();
   if (state_ == DriveState::fault) {
@@ -258,6 +259,7 @@ void Drive<T>::on_tick() noexcept {
       if (r.status != control::IolStatus::ok) trip(FaultCode::singular_control);
       i_command = r.i_cmd_AB_A;
       v = current_input(x, i_command, feasible);
+      record_.iol_boundary = r.boundary;
       if (r.boundary) {
         record_.torque_ref_Nm = double(r.torque_ref_Nm);
         record_.torque_cmd_Nm = double(r.torque_cmd_Nm);

@@ -63,6 +63,7 @@ struct TickRecord {
   double stator_flux2_est_Wb2 = 0.0;
   double i_cmd_A_A = 0.0, i_cmd_B_A = 0.0;  ///< rotor-frame current command
   bool torque_limited = false;
+  bool iol_boundary = false;  ///< the IOL law ran this tick
   bool speed_saturated = false, flux_saturated = false, voltage_clipped = false;
   uint32_t exec_ns = 0;
 };

@@ -219,19 +219,22 @@ void read_speed_reference(Reader& r, Scenario& s) {
   }
 }
 
-void read_load(Reader& r, Scenario& s) {
-  const std::string kind = r.choice("load.kind", "constant", {"constant", "square", "steps"});
+/// A piecewise profile under `prefix`: constant (value_Nm), square (low_Nm, high_Nm, period_s)
+/// or steps (times_s, values_Nm).
+void read_load_like(Reader& r, const std::string& prefix, LoadProfile& p) {
+  const auto key = [&](const char* name) { return prefix + "." + name; };
+  const std::string kind = r.choice(key("kind"), "constant", {"constant", "square", "steps"});
   if (kind == "constant") {
-    s.load.kind = LoadProfile::Kind::constant;
-    s.load.value_Nm = r.number("load.value_Nm", 0.0);
+    p.kind = LoadProfile::Kind::constant;
+    p.value_Nm = r.number(key("value_Nm"), 0.0);
   } else if (kind == "square") {
-    s.load.kind = LoadProfile::Kind::square;
-    s.load.low_Nm = r.number("load.low_Nm", std::nullopt);
-    s.load.high_Nm = r.number("load.high_Nm", std::nullopt);
-    s.load.period_s = r.positive("load.period_s", std::nullopt);
+    p.kind = LoadProfile::Kind::square;
+    p.low_Nm = r.number(key("low_Nm"), std::nullopt);
+    p.high_Nm = r.number(key("high_Nm"), std::nullopt);
+    p.period_s = r.positive(key("period_s"), std::nullopt);
   } else {
-    s.load.kind = LoadProfile::Kind::steps;
-    read_steps(r, "load.times_s", "load.values_Nm", s.load.times_s, s.load.values_Nm);
+    p.kind = LoadProfile::Kind::steps;
+    read_steps(r, key("times_s"), key("values_Nm"), p.times_s, p.values_Nm);
   }
 }
 
@@ -269,7 +272,22 @@ Scenario load_scenario(const std::filesystem::path& path,
     r.fail("drive.sample_period_s",
            fmt::format("= {}: must be in [1e-6, 1e-2] s", s.sample_period_s));
   }
-  s.controller = r.choice("drive.controller", "dsmc", {"dsmc"});
+  s.controller = r.choice("drive.controller", "dsmc", {"dsmc", "iol"});
+  const bool iol = s.controller == "iol";
+  s.iol_period_s = r.positive("drive.iol_period_s", 1e-3);
+  const double ratio = s.iol_period_s / s.sample_period_s;
+  if (std::abs(ratio - std::round(ratio)) > 1e-9 * ratio || ratio < 1.0) {
+    r.fail("drive.iol_period_s", fmt::format("= {}: must be a whole number of drive.sample_period_s", s.iol_period_s));
+  }
+  s.outer_speed_loop = r.boolean("drive.outer_speed_loop", false);
+  s.outer_flux_loop = r.boolean("drive.outer_flux_loop", false);
+  s.speed_loop_bandwidth_rad_s = r.positive("drive.speed_loop_bandwidth_rad_s", 30.0);
+  s.torque_limit_Nm = r.positive("drive.torque_limit_Nm", 240.0);
+  s.flux_loop_time_constant_s = r.positive("drive.flux_loop_time_constant_s", 0.01);
+  s.magnetized_fraction = r.number("drive.magnetized_fraction", 0.95);
+  if (!(s.magnetized_fraction > 0.0 && s.magnetized_fraction <= 1.0)) {
+    r.fail("drive.magnetized_fraction", fmt::format("= {}: must be in (0, 1]", s.magnetized_fraction));
+  }
   s.precision = r.choice("drive.precision", "double", {"double", "float"});
   s.max_accel_rad_s2 = r.positive_or_inf("drive.max_accel_rad_s2");
   s.compensate_latency = r.boolean("drive.compensate_latency", true);
@@ -280,12 +298,21 @@ Scenario load_scenario(const std::filesystem::path& path,
       r.fail(key, fmt::format("= {}: must be in [0, 1)", *value));
   }
 
-  read_speed_reference(r, s);
-  s.flux2_Wb2 = r.positive("reference.flux.flux2_Wb2", std::nullopt);
-  if (s.flux2_Wb2 <= 2e-3) {  // the drive refuses B_k below 1e-3 Wb^2 (DriveConfig)
-    r.fail("reference.flux.flux2_Wb2", fmt::format("= {}: must be > 0.002 Wb^2", s.flux2_Wb2));
+  // The speed reference drives the DSMC and the iol's outer speed loop; the iol without it
+  // follows a torque reference.
+  if (!iol || s.outer_speed_loop || r.find("reference.speed.kind") != nullptr) {
+    read_speed_reference(r, s);
   }
-  read_load(r, s);
+  if (iol) {
+    s.stator_flux2_Wb2 = r.positive("reference.flux.stator_flux2_Wb2", std::nullopt);
+    if (!s.outer_speed_loop) read_load_like(r, "reference.torque", s.torque);
+  } else {
+    s.flux2_Wb2 = r.positive("reference.flux.flux2_Wb2", std::nullopt);
+    if (s.flux2_Wb2 <= 2e-3) {  // the drive refuses B_k below 1e-3 Wb^2 (DriveConfig)
+      r.fail("reference.flux.flux2_Wb2", fmt::format("= {}: must be > 0.002 Wb^2", s.flux2_Wb2));
+    }
+  }
+  read_load_like(r, "load", s.load);
 
   s.ideal_sensors = r.boolean("sensors.ideal", false);
   s.encoder_cpr = static_cast<uint32_t>(r.integer("sensors.encoder_cpr", 8192, 4, 1 << 24));
@@ -330,6 +357,10 @@ Scenario load_scenario(const std::filesystem::path& path,
       r.integer("simulation.seed", 1, 0, std::numeric_limits<int64_t>::max()));
   s.initial_flux2_Wb2 = r.non_negative("simulation.initial_flux2_Wb2", 0.0);
   s.initial_theta_mech_rad = r.number("simulation.initial_theta_mech_rad", 0.0);
+  s.current_fed = r.boolean("simulation.current_fed", false);
+  if (s.current_fed && (!iol || !s.ideal_sensors)) {
+    r.fail("simulation.current_fed", "needs drive.controller = \"iol\" and sensors.ideal = true");
+  }
 
   s.settle_s = r.non_negative("metrics.settle_s", 0.5);
   if (s.settle_s >= s.duration_s) {

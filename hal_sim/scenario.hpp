@@ -26,7 +26,7 @@ struct Scenario {
 
   // [drive]
   double sample_period_s = 1e-4;
-  std::string controller = "dsmc";
+  std::string controller = "dsmc";  ///< "dsmc" (paper 000) or "iol" (paper 001)
   std::string precision = "double";  ///< control arithmetic: "double" or "float"
   double max_accel_rad_s2 = 0.0;     ///< speed reference ramp; inf: none
   bool compensate_latency = true;    ///< predict over the PWM latency
@@ -35,7 +35,16 @@ struct Scenario {
 
   // [reference.speed], [reference.flux]
   SpeedProfile speed;
-  double flux2_Wb2 = 0.2;
+  double flux2_Wb2 = 0.2;         ///< squared rotor flux (dsmc)
+  double stator_flux2_Wb2 = 0.0;  ///< squared stator flux (iol)
+  LoadProfile torque;             ///< torque reference (iol without the outer speed loop)
+
+  // [drive] for the iol controller
+  double iol_period_s = 1e-3;
+  bool outer_speed_loop = false, outer_flux_loop = false;
+  double speed_loop_bandwidth_rad_s = 30.0, torque_limit_Nm = 240.0;
+  double flux_loop_time_constant_s = 0.01;
+  double magnetized_fraction = 0.95;
 
   LoadProfile load;
 
@@ -62,6 +71,7 @@ struct Scenario {
   uint64_t seed = 1;
   double initial_flux2_Wb2 = 0.0;       ///< start magnetized at rest with this squared flux
   double initial_theta_mech_rad = 0.0;  ///< rotor position at the start
+  bool current_fed = false;  ///< the ideal current source drives the motor (paper 001)
 
   // [metrics]
   double settle_s = 0.5;

@@ -14,6 +14,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <iostream>
+#include <iterator>
 #include <optional>
 #include <string>
 #include <system_error>
@@ -34,11 +35,26 @@ namespace {
 constexpr int kExitBadInput = 2;
 constexpr int kExitOutputFailed = 1;
 
-constexpr const char* kCsvHeader =
-    "t_s,omega_mech_rad_s,omega_ref_rad_s,omega_est_rad_s,flux2_Wb2,flux2_ref_Wb2,flux2_est_Wb2,"
-    "load_Nm,load_est_Nm,i_alpha_A,i_beta_A,v_alpha_V,v_beta_V,discriminant,c_k,"
-    "flux_A_Wb,flux_B_Wb,flux_A_est_Wb,flux_B_est_Wb,theta_mech_rad,theta_est_rad,torque_Nm,"
-    "state,saturated\n";
+/// The CSV columns (docs/scenarios.md): one table for the header and the rows.
+struct Column {
+  const char* name;
+  double (*value)(const imd::sim::SimRow&);
+};
+#define IMD_COLUMN(field) \
+  Column { #field, [](const imd::sim::SimRow& r) { return static_cast<double>(r.field); } }
+const Column kColumns[] = {
+    IMD_COLUMN(t_s),           IMD_COLUMN(omega_mech_rad_s), IMD_COLUMN(omega_ref_rad_s),
+    IMD_COLUMN(omega_est_rad_s), IMD_COLUMN(flux2_Wb2),      IMD_COLUMN(flux2_ref_Wb2),
+    IMD_COLUMN(flux2_est_Wb2), IMD_COLUMN(load_Nm),          IMD_COLUMN(load_est_Nm),
+    IMD_COLUMN(i_alpha_A),     IMD_COLUMN(i_beta_A),         IMD_COLUMN(v_alpha_V),
+    IMD_COLUMN(v_beta_V),      IMD_COLUMN(discriminant),     IMD_COLUMN(c_k),
+    IMD_COLUMN(flux_A_Wb),     IMD_COLUMN(flux_B_Wb),        IMD_COLUMN(flux_A_est_Wb),
+    IMD_COLUMN(flux_B_est_Wb), IMD_COLUMN(theta_mech_rad),   IMD_COLUMN(theta_est_rad),
+    IMD_COLUMN(torque_Nm),     IMD_COLUMN(torque_ref_Nm),    IMD_COLUMN(y2),
+    IMD_COLUMN(y2_ref),        IMD_COLUMN(stator_flux2_Wb2), IMD_COLUMN(stator_flux2_ref_Wb2),
+    IMD_COLUMN(iol_boundary),  IMD_COLUMN(state),            IMD_COLUMN(saturated),
+};
+#undef IMD_COLUMN
 
 nlohmann::ordered_json summary_json(const imd::sim::Scenario& s, const imd::sim::Summary& r) {
   nlohmann::ordered_json faults = nlohmann::ordered_json::array();
@@ -52,6 +68,7 @@ nlohmann::ordered_json summary_json(const imd::sim::Scenario& s, const imd::sim:
           {"flux2_rms_err_Wb2", r.flux2_rms_err_Wb2},
           {"flux2_max_err_Wb2", r.flux2_max_err_Wb2},
           {"load_est_rms_err_Nm", r.load_est_rms_err_Nm},
+          {"torque_rms_err_Nm", r.torque_rms_err_Nm},
           {"i_peak_A", r.i_peak_A},
           {"i_peak_total_A", r.i_peak_total_A},
           {"i_max_A", std::isfinite(s.i_max_A) ? nlohmann::ordered_json(s.i_max_A)
@@ -127,21 +144,21 @@ int main(int argc, char** argv) {
       std::cerr << "drive_sim: cannot write " << csv_path << '\n';
       return kExitOutputFailed;
     }
-    std::fputs(kCsvHeader, csv);
+    for (const Column& column : kColumns) {
+      std::fputs(column.name, csv);
+      std::fputc(&column == &kColumns[std::size(kColumns) - 1] ? '\n' : ',', csv);
+    }
   }
 
   imd::sim::RunCallbacks callbacks;
   if (csv != nullptr) {
     callbacks.row = [&](const imd::sim::SimRow& r) {
-      fmt::print(
-          csv,
-          "{:.6f},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.6g},{:.6g},{:.6g},{:.6g},"
-          "{:.6g},{:.6g},{:.8g},{:.8g},{:.8g},{:.8g},{:.8g},{:.8g},{:.8g},{:.8g},{:.6g},{},{}\n",
-          r.t_s, r.omega_mech_rad_s, r.omega_ref_rad_s, r.omega_est_rad_s, r.flux2_Wb2,
-          r.flux2_ref_Wb2, r.flux2_est_Wb2, r.load_Nm, r.load_est_Nm, r.i_alpha_A, r.i_beta_A,
-          r.v_alpha_V, r.v_beta_V, r.discriminant, r.c_k, r.flux_A_Wb, r.flux_B_Wb, r.flux_A_est_Wb,
-          r.flux_B_est_Wb, r.theta_mech_rad, r.theta_est_rad, r.torque_Nm, r.state,
-          r.saturated ? 1 : 0);
+      fmt::memory_buffer line;
+      for (const Column& column : kColumns) {
+        fmt::format_to(std::back_inserter(line), "{:.10g},", column.value(r));
+      }
+      line[line.size() - 1] = '\n';
+      std::fwrite(line.data(), 1, line.size(), csv);
     };
   }
   callbacks.progress = [&](double simulated_s, double wall_s) {

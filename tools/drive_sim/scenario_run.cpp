@@ -3,6 +3,7 @@
 #include <chrono>
 #include <cmath>
 
+#include "control/exact_model_001.hpp"
 #include "control/frames.hpp"
 #include "firmware/drive.hpp"
 #include "hal_sim/sim_board.hpp"
@@ -14,7 +15,8 @@ class ScenarioReferences final : public firmware::ReferenceSource {
  public:
   explicit ScenarioReferences(const Scenario& s) : s_(s) {}
   firmware::Reference at_tick(uint64_t k) const noexcept override {
-    return {s_.speed.at(double(k) * s_.sample_period_s), s_.flux2_Wb2};
+    const double t_s = double(k) * s_.sample_period_s;
+    return {s_.speed.at(t_s), s_.flux2_Wb2, s_.torque.at(t_s), s_.stator_flux2_Wb2};
   }
 
  private:
@@ -45,6 +47,7 @@ SimBoardConfig board_config(const Scenario& s) {
   c.substeps = s.substeps;
   c.pwm_latency_ticks = s.pwm_latency_ticks;
   c.inner_feedback = s.inner_feedback;
+  c.current_source = s.current_fed;
   c.v_bus_V = s.v_bus_V;
   c.encoder_cpr = s.encoder_cpr;
   c.adc = s.adc;
@@ -55,6 +58,15 @@ SimBoardConfig board_config(const Scenario& s) {
 firmware::DriveConfig drive_config(const Scenario& s) {
   firmware::DriveConfig c;
   c.sample_period_s = s.sample_period_s;
+  c.controller = s.controller == "iol" ? firmware::ControllerKind::iol : firmware::ControllerKind::dsmc;
+  c.iol_period_s = s.iol_period_s;
+  c.current_source = s.current_fed;
+  c.outer_speed_loop = s.outer_speed_loop;
+  c.outer_flux_loop = s.outer_flux_loop;
+  c.speed_loop_bandwidth_rad_s = s.speed_loop_bandwidth_rad_s;
+  c.torque_limit_Nm = s.torque_limit_Nm;
+  c.flux_loop_time_constant_s = s.flux_loop_time_constant_s;
+  c.magnetized_fraction = s.magnetized_fraction;
   c.analog_inner_loop = s.inner_feedback == InnerFeedback::ideal_analog;
   c.pwm_latency_ticks = s.pwm_latency_ticks;
   c.compensate_latency = s.compensate_latency;
@@ -90,7 +102,8 @@ Summary run(const Scenario& s, const RunCallbacks& callbacks) {
   const PlantOracle oracle(board);
   firmware::Drive<T> drive(
       s.motor, drive_config(s),
-      {board.pwm(), board.encoder(), board.adc(), board.timer(), &board.analog_inner_loop()},
+      {board.pwm(), board.encoder(), board.adc(), board.timer(), &board.analog_inner_loop(),
+       &board.current_source()},
       references, s.ideal_sensors ? &oracle : nullptr);
   board.timer().start(drive);
 
@@ -99,7 +112,13 @@ Summary run(const Scenario& s, const RunCallbacks& callbacks) {
   auto last_progress = wall_start;
   const auto ticks = static_cast<uint64_t>(std::llround(s.duration_s / s.sample_period_s));
   const control::MotorParameters& m = s.motor;
-  double speed_sq = 0, flux_sq = 0, load_sq = 0;
+  double speed_sq = 0, flux_sq = 0, load_sq = 0, torque_sq = 0;
+  uint64_t torque_count = 0;
+  const bool iol = s.controller == "iol";
+  const double flux_decay = control::discretize_seed001(m, s.iol_period_s).flux_decay;
+  Vec2 boundary_flux_s = Vec2::Zero();  // true stator flux (rotor frame) at the last boundary
+  double pending_torque_cmd = std::nan("");  // the law's v1, due at the next boundary
+  SimRow held;                               // iol outputs held between boundaries
   uint64_t measured = 0, saturated = 0;
   firmware::FaultCode last_fault = firmware::FaultCode::none;
   for (uint64_t k = 0; k < ticks; ++k) {
@@ -112,7 +131,6 @@ Summary run(const Scenario& s, const RunCallbacks& callbacks) {
       break;
     }
     const double load_Nm = board.load_Nm();
-    const double torque_Nm = board.plant().torque_Nm();
     board.run_tick();
     const firmware::TickRecord& rec = drive.record();
 
@@ -140,7 +158,28 @@ Summary run(const Scenario& s, const RunCallbacks& callbacks) {
     row.c_k = rec.c_k;
     row.theta_mech_rad = truth.theta_mech_rad;
     row.theta_est_rad = rec.theta_est_rad;
-    row.torque_Nm = torque_Nm;
+    row.torque_Nm = board.start_torque_Nm();
+    {
+      const Vec2 flux_s_AB = rotor.apply_inverse(board.start_flux_s_alphabeta_Wb());
+      row.stator_flux2_Wb2 = flux_s_AB.squaredNorm();
+      row.stator_flux2_ref_Wb2 = s.stator_flux2_Wb2;
+      row.iol_boundary = rec.iol_boundary;
+      if (rec.iol_boundary) {
+        // y2 of (20) from the true stator fluxes of this and the last boundary.
+        held.y2 = flux_s_AB.dot(boundary_flux_s) - flux_decay * boundary_flux_s.squaredNorm();
+        boundary_flux_s = flux_s_AB;
+        if (std::isfinite(pending_torque_cmd) && t_s > s.settle_s) {
+          torque_sq += (row.torque_Nm - pending_torque_cmd) * (row.torque_Nm - pending_torque_cmd);
+          ++torque_count;
+        }
+        pending_torque_cmd = rec.torque_cmd_Nm;
+        held.torque_ref_Nm = rec.torque_ref_Nm;
+        held.y2_ref = rec.y2_ref;
+      }
+      row.y2 = held.y2;
+      row.y2_ref = held.y2_ref;
+      row.torque_ref_Nm = held.torque_ref_Nm;
+    }
     row.state = static_cast<int>(rec.state);
     row.saturated = rec.speed_saturated || rec.flux_saturated || rec.voltage_clipped;
 
@@ -154,7 +193,8 @@ Summary run(const Scenario& s, const RunCallbacks& callbacks) {
     }
     if (t_s > s.settle_s) {
       const double speed_err = row.omega_mech_rad_s - row.omega_ref_rad_s;
-      const double flux_err = row.flux2_Wb2 - row.flux2_ref_Wb2;
+      const double flux_err = iol ? row.stator_flux2_Wb2 - row.stator_flux2_ref_Wb2
+                                  : row.flux2_Wb2 - row.flux2_ref_Wb2;
       speed_sq += speed_err * speed_err;
       flux_sq += flux_err * flux_err;
       load_sq += (row.load_est_Nm - row.load_Nm) * (row.load_est_Nm - row.load_Nm);
@@ -187,6 +227,8 @@ Summary run(const Scenario& s, const RunCallbacks& callbacks) {
   if (measured == 0) {
     summary.speed_max_err_rad_s = summary.flux2_max_err_Wb2 = summary.i_peak_A = std::nan("");
   }
+  summary.torque_rms_err_Nm =
+      torque_count > 0 ? std::sqrt(torque_sq / double(torque_count)) : std::nan("");
   summary.tick_exec_ns_mean = drive.execution().mean_ns();
   summary.tick_exec_ns_max = drive.execution().max_ns;
   return summary;

@@ -21,7 +21,11 @@ struct SimRow {
   double discriminant = 0.0, c_k = 0.0;
   double flux_A_Wb = 0.0, flux_B_Wb = 0.0, flux_A_est_Wb = 0.0, flux_B_est_Wb = 0.0;
   double theta_mech_rad = 0.0, theta_est_rad = 0.0;
-  double torque_Nm = 0.0;
+  double torque_Nm = 0.0;  ///< at the start of the period, with its current
+  // The current-fed controller (iol): at T0 boundaries (iol_boundary), else held.
+  double torque_ref_Nm = 0.0, y2 = 0.0, y2_ref = 0.0, stator_flux2_Wb2 = 0.0;
+  double stator_flux2_ref_Wb2 = 0.0;
+  bool iol_boundary = false;
   int state = 0;
   bool saturated = false;
 };
@@ -37,6 +41,7 @@ struct Summary {
   double speed_rms_err_rad_s = 0.0, speed_max_err_rad_s = 0.0;
   double flux2_rms_err_Wb2 = 0.0, flux2_max_err_Wb2 = 0.0;
   double load_est_rms_err_Nm = 0.0;
+  double torque_rms_err_Nm = 0.0;  ///< iol: torque against the law's command one T0 earlier
   double i_peak_A = 0.0, i_peak_total_A = 0.0;
   double saturated_fraction = 0.0;
   uint64_t ticks = 0;
