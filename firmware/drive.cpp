@@ -254,8 +254,10 @@ void Drive<T>::on_tick() noexcept {
       }
     }
     if (state_ == DriveState::running && config_.controller == ControllerKind::iol) {
-      const Reference boundary_ref = references_.at_tick(k + uint64_t(iol_stage_.ticks_per_period()));
-      const IolTickResult<T> r = iol_stage_.tick(e.x.flux_r_AB_Wb, e.x.omega_mech_rad_s, boundary_ref);
+      const Reference boundary_ref =
+          references_.at_tick(k + uint64_t(iol_stage_.ticks_per_period()));
+      const IolTickResult<T> r =
+          iol_stage_.tick(e.x.flux_r_AB_Wb, e.x.omega_mech_rad_s, boundary_ref);
       if (r.status != control::IolStatus::ok) trip(FaultCode::singular_control);
       i_command = r.i_cmd_AB_A;
       v = current_input(x, i_command, feasible);

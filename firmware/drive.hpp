@@ -36,7 +36,7 @@ struct DrivePeripherals {
   hal::CurrentAdc& adc;
   hal::ControlTimer& timer;
   hal::AnalogInnerLoop* analog_inner_loop = nullptr;  ///< only with config.analog_inner_loop
-  hal::CurrentSource* current_source = nullptr;        ///< only with config.current_source
+  hal::CurrentSource* current_source = nullptr;       ///< only with config.current_source
 };
 
 template <typename T>
@@ -72,7 +72,8 @@ class Drive final : public hal::TickHandler {
                      const control::InputDisk<T>& feasible) const noexcept;
   /// The magnetizing current: along the flux (the A axis while there is none), of the size that
   /// holds the reference flux in steady state (rotor flux for the DSMC, stator flux for the IOL).
-  Vec2 magnetizing_current(const control::RotorFrameState<T>& x, const Reference& ref) const noexcept;
+  Vec2 magnetizing_current(const control::RotorFrameState<T>& x,
+                           const Reference& ref) const noexcept;
   /// The squared flux the start-up waits for, and its reference.
   T magnetized_flux2(const control::RotorFrameState<T>& x) const noexcept;
   T magnetized_flux2_ref(const Reference& ref) const noexcept;

@@ -24,12 +24,12 @@ struct DriveConfig {
   bool compensate_latency = true;
 
   // The current-fed controller (iol).
-  double iol_period_s = 1e-3;                ///< T0, a whole number of sample periods
+  double iol_period_s = 1e-3;  ///< T0, a whole number of sample periods
   /// Drive the ideal current source (paper 001's current-fed plant; simulation only) instead of
   /// the inner current loop on the PWM.
   bool current_source = false;
-  bool outer_speed_loop = false;             ///< v1 from a speed PI (else the torque reference)
-  bool outer_flux_loop = false;              ///< v2 from the Fig. 5 loop (else from (21))
+  bool outer_speed_loop = false;  ///< v1 from a speed PI (else the torque reference)
+  bool outer_flux_loop = false;   ///< v2 from the Fig. 5 loop (else from (21))
   double speed_loop_bandwidth_rad_s = 30.0;
   double torque_limit_Nm = 240.0;
   double flux_loop_time_constant_s = 0.01;

@@ -22,7 +22,7 @@ namespace imd::firmware {
 template <typename T>
 struct IolTickResult {
   control::Vec2<T> i_cmd_AB_A = control::Vec2<T>::Zero();  ///< current to impose this tick
-  bool boundary = false;          ///< the law ran this tick
+  bool boundary = false;                                   ///< the law ran this tick
   control::IolStatus status = control::IolStatus::ok;
   T torque_ref_Nm = T(0), torque_cmd_Nm = T(0);  ///< v1 before and after the guard
   T y2_ref = T(0), y2 = T(0);                    ///< v2, and y2(k) from the flux estimates
@@ -41,7 +41,8 @@ class IolStage {
                                                   config.flux_loop_time_constant_s)),
         speed_pi_(control::design_speed_pi(motor.J_kgm2, config.speed_loop_bandwidth_rad_s,
                                            config.torque_limit_Nm, config.iol_period_s)),
-        ticks_per_period_(static_cast<int>(std::lround(config.iol_period_s / config.sample_period_s))),
+        ticks_per_period_(
+            static_cast<int>(std::lround(config.iol_period_s / config.sample_period_s))),
         outer_speed_loop_(config.outer_speed_loop),
         outer_flux_loop_(config.outer_flux_loop),
         sigma_H_(T(motor.Ls_H - motor.Lm_H * motor.Lm_H / motor.Lr_H)),
@@ -52,7 +53,7 @@ class IolStage {
 
   /// Starts the law with this current held (the magnetizing current).
   void start(const control::Vec2<T>& i_held_AB_A) noexcept {
-    i_held_ = i_held_AB_A;
+    i_held_ = i_next_ = i_held_AB_A;
     ticks_ = 0;
     flux_s_before_.setZero();
     flux_loop_.reset();
@@ -64,16 +65,22 @@ class IolStage {
   IolTickResult<T> tick(const control::Vec2<T>& flux_r_AB_Wb, T omega_mech_rad_s,
                         const Reference& ref_next) noexcept {
     IolTickResult<T> r;
+    if (ticks_++ % ticks_per_period_ == 0) {
+      // A boundary: the current computed one period ago, u(k-1) = i(t_k), is imposed now and
+      // held until the next boundary; the law computes u(k) = i(t_{k+1}) (augmented model (19)).
+      i_held_ = i_next_;
+      r.boundary = true;
+    }
     r.i_cmd_AB_A = i_held_;
-    if (ticks_++ % ticks_per_period_ != 0) return r;
-    r.boundary = true;
+    if (!r.boundary) return r;
     // The stator flux just after the current stepped to the held value (15).
     const control::Vec2<T> flux_s = sigma_H_ * i_held_ + Lm_over_Lr_ * flux_r_AB_Wb;
     r.flux2_s_Wb2 = flux_s.squaredNorm();
     r.y2 = law_.y2(flux_s, flux_s_before_);
     flux_s_before_ = flux_s;
-    r.torque_ref_Nm = outer_speed_loop_ ? speed_pi_.step(T(ref_next.omega_mech_rad_s), omega_mech_rad_s)
-                                        : T(ref_next.torque_Nm);
+    r.torque_ref_Nm = outer_speed_loop_
+                          ? speed_pi_.step(T(ref_next.omega_mech_rad_s), omega_mech_rad_s)
+                          : T(ref_next.torque_Nm);
     const T flux2_ref = T(ref_next.stator_flux2_Wb2);
     r.y2_ref = outer_flux_loop_ ? flux_loop_.step(flux2_ref, r.flux2_s_Wb2)
                                 : (T(1) - T(coefficients_.flux_decay)) * flux2_ref;  // (21)
@@ -81,7 +88,7 @@ class IolStage {
     r.status = out.status;
     r.torque_cmd_Nm = out.torque_cmd_Nm;
     r.torque_limited = out.torque_limited;
-    i_held_ = out.i_next_AB_A;  // imposed from the next boundary on, (19)
+    i_next_ = out.i_next_AB_A;
     return r;
   }
 
@@ -93,7 +100,8 @@ class IolStage {
   int ticks_per_period_;
   bool outer_speed_loop_, outer_flux_loop_;
   T sigma_H_, Lm_over_Lr_;
-  control::Vec2<T> i_held_ = control::Vec2<T>::Zero();
+  control::Vec2<T> i_held_ = control::Vec2<T>::Zero();  ///< imposed over this period, u(k-1)
+  control::Vec2<T> i_next_ = control::Vec2<T>::Zero();  ///< for the next period, u(k)
   control::Vec2<T> flux_s_before_ = control::Vec2<T>::Zero();
   uint64_t ticks_ = 0;
 };

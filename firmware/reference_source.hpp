@@ -8,9 +8,9 @@ namespace imd::firmware {
 
 struct Reference {
   double omega_mech_rad_s = 0.0;
-  double flux2_Wb2 = 0.0;          ///< squared rotor-flux modulus (DSMC)
-  double torque_Nm = 0.0;          ///< torque (IOL without the outer speed loop)
-  double stator_flux2_Wb2 = 0.0;   ///< squared stator-flux modulus (IOL)
+  double flux2_Wb2 = 0.0;         ///< squared rotor-flux modulus (DSMC)
+  double torque_Nm = 0.0;         ///< torque (IOL without the outer speed loop)
+  double stator_flux2_Wb2 = 0.0;  ///< squared stator-flux modulus (IOL)
 };
 
 class ReferenceSource {

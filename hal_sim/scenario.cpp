@@ -277,7 +277,8 @@ Scenario load_scenario(const std::filesystem::path& path,
   s.iol_period_s = r.positive("drive.iol_period_s", 1e-3);
   const double ratio = s.iol_period_s / s.sample_period_s;
   if (std::abs(ratio - std::round(ratio)) > 1e-9 * ratio || ratio < 1.0) {
-    r.fail("drive.iol_period_s", fmt::format("= {}: must be a whole number of drive.sample_period_s", s.iol_period_s));
+    r.fail("drive.iol_period_s",
+           fmt::format("= {}: must be a whole number of drive.sample_period_s", s.iol_period_s));
   }
   s.outer_speed_loop = r.boolean("drive.outer_speed_loop", false);
   s.outer_flux_loop = r.boolean("drive.outer_flux_loop", false);
@@ -286,7 +287,8 @@ Scenario load_scenario(const std::filesystem::path& path,
   s.flux_loop_time_constant_s = r.positive("drive.flux_loop_time_constant_s", 0.01);
   s.magnetized_fraction = r.number("drive.magnetized_fraction", 0.95);
   if (!(s.magnetized_fraction > 0.0 && s.magnetized_fraction <= 1.0)) {
-    r.fail("drive.magnetized_fraction", fmt::format("= {}: must be in (0, 1]", s.magnetized_fraction));
+    r.fail("drive.magnetized_fraction",
+           fmt::format("= {}: must be in (0, 1]", s.magnetized_fraction));
   }
   s.precision = r.choice("drive.precision", "double", {"double", "float"});
   s.max_accel_rad_s2 = r.positive_or_inf("drive.max_accel_rad_s2");

@@ -26,7 +26,7 @@ struct Scenario {
 
   // [drive]
   double sample_period_s = 1e-4;
-  std::string controller = "dsmc";  ///< "dsmc" (paper 000) or "iol" (paper 001)
+  std::string controller = "dsmc";   ///< "dsmc" (paper 000) or "iol" (paper 001)
   std::string precision = "double";  ///< control arithmetic: "double" or "float"
   double max_accel_rad_s2 = 0.0;     ///< speed reference ramp; inf: none
   bool compensate_latency = true;    ///< predict over the PWM latency
@@ -71,7 +71,7 @@ struct Scenario {
   uint64_t seed = 1;
   double initial_flux2_Wb2 = 0.0;       ///< start magnetized at rest with this squared flux
   double initial_theta_mech_rad = 0.0;  ///< rotor position at the start
-  bool current_fed = false;  ///< the ideal current source drives the motor (paper 001)
+  bool current_fed = false;             ///< the ideal current source drives the motor (paper 001)
 
   // [metrics]
   double settle_s = 0.5;

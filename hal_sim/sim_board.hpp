@@ -29,7 +29,7 @@ struct SimBoardConfig {
   int substeps = 10;          ///< RK4 steps per period
   int pwm_latency_ticks = 1;  ///< 0 or 1
   InnerFeedback inner_feedback = InnerFeedback::digital;
-  bool current_source = false;       ///< the ideal current source drives the motor
+  bool current_source = false;  ///< the ideal current source drives the motor
   double v_bus_V = 311.0;
   uint32_t encoder_cpr = 8192;
   AdcModelConfig adc;

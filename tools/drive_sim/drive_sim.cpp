@@ -40,19 +40,41 @@ struct Column {
   const char* name;
   double (*value)(const imd::sim::SimRow&);
 };
-#define IMD_COLUMN(field) \
-  Column { #field, [](const imd::sim::SimRow& r) { return static_cast<double>(r.field); } }
+#define IMD_COLUMN(field)                                                          \
+  Column {                                                                         \
+#field, [](const imd::sim::SimRow& r) { return static_cast<double>(r.field); } \
+  }
 const Column kColumns[] = {
-    IMD_COLUMN(t_s),           IMD_COLUMN(omega_mech_rad_s), IMD_COLUMN(omega_ref_rad_s),
-    IMD_COLUMN(omega_est_rad_s), IMD_COLUMN(flux2_Wb2),      IMD_COLUMN(flux2_ref_Wb2),
-    IMD_COLUMN(flux2_est_Wb2), IMD_COLUMN(load_Nm),          IMD_COLUMN(load_est_Nm),
-    IMD_COLUMN(i_alpha_A),     IMD_COLUMN(i_beta_A),         IMD_COLUMN(v_alpha_V),
-    IMD_COLUMN(v_beta_V),      IMD_COLUMN(discriminant),     IMD_COLUMN(c_k),
-    IMD_COLUMN(flux_A_Wb),     IMD_COLUMN(flux_B_Wb),        IMD_COLUMN(flux_A_est_Wb),
-    IMD_COLUMN(flux_B_est_Wb), IMD_COLUMN(theta_mech_rad),   IMD_COLUMN(theta_est_rad),
-    IMD_COLUMN(torque_Nm),     IMD_COLUMN(torque_ref_Nm),    IMD_COLUMN(y2),
-    IMD_COLUMN(y2_ref),        IMD_COLUMN(stator_flux2_Wb2), IMD_COLUMN(stator_flux2_ref_Wb2),
-    IMD_COLUMN(iol_boundary),  IMD_COLUMN(state),            IMD_COLUMN(saturated),
+    IMD_COLUMN(t_s),
+    IMD_COLUMN(omega_mech_rad_s),
+    IMD_COLUMN(omega_ref_rad_s),
+    IMD_COLUMN(omega_est_rad_s),
+    IMD_COLUMN(flux2_Wb2),
+    IMD_COLUMN(flux2_ref_Wb2),
+    IMD_COLUMN(flux2_est_Wb2),
+    IMD_COLUMN(load_Nm),
+    IMD_COLUMN(load_est_Nm),
+    IMD_COLUMN(i_alpha_A),
+    IMD_COLUMN(i_beta_A),
+    IMD_COLUMN(v_alpha_V),
+    IMD_COLUMN(v_beta_V),
+    IMD_COLUMN(discriminant),
+    IMD_COLUMN(c_k),
+    IMD_COLUMN(flux_A_Wb),
+    IMD_COLUMN(flux_B_Wb),
+    IMD_COLUMN(flux_A_est_Wb),
+    IMD_COLUMN(flux_B_est_Wb),
+    IMD_COLUMN(theta_mech_rad),
+    IMD_COLUMN(theta_est_rad),
+    IMD_COLUMN(torque_Nm),
+    IMD_COLUMN(torque_ref_Nm),
+    IMD_COLUMN(y2),
+    IMD_COLUMN(y2_ref),
+    IMD_COLUMN(stator_flux2_Wb2),
+    IMD_COLUMN(stator_flux2_ref_Wb2),
+    IMD_COLUMN(iol_boundary),
+    IMD_COLUMN(state),
+    IMD_COLUMN(saturated),
 };
 #undef IMD_COLUMN
 

@@ -58,7 +58,8 @@ SimBoardConfig board_config(const Scenario& s) {
 firmware::DriveConfig drive_config(const Scenario& s) {
   firmware::DriveConfig c;
   c.sample_period_s = s.sample_period_s;
-  c.controller = s.controller == "iol" ? firmware::ControllerKind::iol : firmware::ControllerKind::dsmc;
+  c.controller =
+      s.controller == "iol" ? firmware::ControllerKind::iol : firmware::ControllerKind::dsmc;
   c.iol_period_s = s.iol_period_s;
   c.current_source = s.current_fed;
   c.outer_speed_loop = s.outer_speed_loop;
@@ -100,11 +101,10 @@ Summary run(const Scenario& s, const RunCallbacks& callbacks) {
   }
   const ScenarioReferences references(s);
   const PlantOracle oracle(board);
-  firmware::Drive<T> drive(
-      s.motor, drive_config(s),
-      {board.pwm(), board.encoder(), board.adc(), board.timer(), &board.analog_inner_loop(),
-       &board.current_source()},
-      references, s.ideal_sensors ? &oracle : nullptr);
+  firmware::Drive<T> drive(s.motor, drive_config(s),
+                           {board.pwm(), board.encoder(), board.adc(), board.timer(),
+                            &board.analog_inner_loop(), &board.current_source()},
+                           references, s.ideal_sensors ? &oracle : nullptr);
   board.timer().start(drive);
 
   Summary summary;
@@ -116,7 +116,7 @@ Summary run(const Scenario& s, const RunCallbacks& callbacks) {
   uint64_t torque_count = 0;
   const bool iol = s.controller == "iol";
   const double flux_decay = control::discretize_seed001(m, s.iol_period_s).flux_decay;
-  Vec2 boundary_flux_s = Vec2::Zero();  // true stator flux (rotor frame) at the last boundary
+  Vec2 boundary_flux_s = Vec2::Zero();       // true stator flux (rotor frame) at the last boundary
   double pending_torque_cmd = std::nan("");  // the law's v1, due at the next boundary
   SimRow held;                               // iol outputs held between boundaries
   uint64_t measured = 0, saturated = 0;
@@ -193,8 +193,8 @@ Summary run(const Scenario& s, const RunCallbacks& callbacks) {
     }
     if (t_s > s.settle_s) {
       const double speed_err = row.omega_mech_rad_s - row.omega_ref_rad_s;
-      const double flux_err = iol ? row.stator_flux2_Wb2 - row.stator_flux2_ref_Wb2
-                                  : row.flux2_Wb2 - row.flux2_ref_Wb2;
+      const double flux_err =
+          iol ? row.stator_flux2_Wb2 - row.stator_flux2_ref_Wb2 : row.flux2_Wb2 - row.flux2_ref_Wb2;
       speed_sq += speed_err * speed_err;
       flux_sq += flux_err * flux_err;
       load_sq += (row.load_est_Nm - row.load_Nm) * (row.load_est_Nm - row.load_Nm);

@@ -1,0 +1,72 @@
+// The seed-001 scenarios end to end: the current-fed controller of paper 001 in the firmware's
+// tick, on the simulated board.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <vector>
+
+#include "control/exact_model_001.hpp"
+#include "hal_sim/scenario.hpp"
+#include "test_motors.hpp"
+#include "tools/drive_sim/scenario_run.hpp"
+
+namespace imd::sim {
+namespace {
+
+Scenario scenario(const std::string& name, const std::vector<std::string>& overrides = {}) {
+  return load_scenario(test::source_path("hal_sim/scenarios/" + name), overrides);
+}
+
+TEST(Seed001Paper, DecouplesExactlyAndSettlesTheFlux) {
+  const Scenario s = scenario("seed001_paper.toml");
+  std::vector<SimRow> boundaries;
+  bool finite = true;
+  const Summary r = run_scenario(s, {[&](const SimRow& row) {
+                                       finite = finite && std::isfinite(row.stator_flux2_Wb2) &&
+                                                std::isfinite(row.omega_mech_rad_s) &&
+                                                std::isfinite(row.torque_Nm);
+                                       if (row.iol_boundary) boundaries.push_back(row);
+                                     },
+                                     {}});
+  ASSERT_TRUE(r.faults.empty());
+  EXPECT_TRUE(finite);  // no state diverges over the 3 s (internal dynamics)
+  ASSERT_GT(boundaries.size(), 2900u);
+
+  // (25): torque(k+1) = v1(k) and y2(k+1) = v2(k). The plant integrates the current-fed motor
+  // with RK4 (h = 10 us) against the exact model; their one-step agreement is 1e-14
+  // (ExactModel001.OneStepMatchesTheCurrentFedPlant), so 1e-9 leaves room for 3000 steps of
+  // rounding. Torque errors are relative to max(|v1|, 1 N m): v1 is 0 before the step.
+  double worst_torque = 0.0, worst_y2 = 0.0;
+  for (std::size_t k = 1; k + 1 < boundaries.size(); ++k) {
+    const SimRow& now = boundaries[k];
+    const SimRow& next = boundaries[k + 1];
+    worst_torque = std::max(worst_torque, std::abs(next.torque_Nm - now.torque_ref_Nm) /
+                                              std::max(std::abs(now.torque_ref_Nm), 1.0));
+    worst_y2 = std::max(worst_y2, std::abs(next.y2 - now.y2_ref) / std::abs(now.y2_ref));
+  }
+  std::printf("seed001 paper: worst relative error torque %.2e, y2 %.2e\n", worst_torque, worst_y2);
+  EXPECT_LE(worst_torque, 1e-9);
+  EXPECT_LE(worst_y2, 1e-9);
+
+  // The squared stator flux settles within 1 % of the target set through (21)...
+  const SimRow& last = boundaries.back();
+  EXPECT_NEAR(last.stator_flux2_Wb2, s.stator_flux2_Wb2, 0.01 * s.stator_flux2_Wb2);
+  // ... and slightly above it, by what the slip explains: (21) drops cos(w_sl T0), and in steady
+  // state F = (1 - e) F_ref / (cos(w_sl T0) - e). The slip angle per period is the rotor
+  // flux's turn in the rotor frame. Measured: 0.05 % apart at 3 s. What is left of the
+  // flux transient after the torque step (pole e = 0.998 per period, 2 s: e^-4.3 of a 0.2 %
+  // change) stays below 2 % of the excess.
+  const SimRow& before = boundaries[boundaries.size() - 2];
+  const double slip_T0 =
+      std::atan2(last.flux_B_Wb, last.flux_A_Wb) - std::atan2(before.flux_B_Wb, before.flux_A_Wb);
+  const double e = control::discretize_seed001(s.motor, s.iol_period_s).flux_decay;
+  const double predicted = (1.0 - e) * s.stator_flux2_Wb2 / (std::cos(slip_T0) - e);
+  const double excess = last.stator_flux2_Wb2 - s.stator_flux2_Wb2;
+  EXPECT_GT(excess, 0.0);
+  EXPECT_NEAR(excess, predicted - s.stator_flux2_Wb2, 0.02 * (predicted - s.stator_flux2_Wb2));
+  std::printf("seed001 paper: flux^2 %.6f (target %.1f), slip %.3f rad/s, predicted %.6f\n",
+              last.stator_flux2_Wb2, s.stator_flux2_Wb2, slip_T0 / s.iol_period_s, predicted);
+}
+
+}  // namespace
+}  // namespace imd::sim
