@@ -106,8 +106,10 @@ nlohmann::ordered_json summary_json(const imd::sim::Scenario& s, const imd::sim:
           {"faults", faults}};
 }
 
-std::string plot_script() {
-  return (std::filesystem::path(IMD_SOURCE_DIR) / "tools" / "plot_seed000.py").string();
+/// The plot script for the scenario's controller: paper 000's figures or paper 001's.
+std::string plot_script(const imd::sim::Scenario& scenario) {
+  const char* name = scenario.controller == "iol" ? "plot_seed001.py" : "plot_seed000.py";
+  return (std::filesystem::path(IMD_SOURCE_DIR) / "tools" / name).string();
 }
 
 /// Runs a program with these arguments (no shell, so no quoting) and returns its exit status.
@@ -211,11 +213,11 @@ int main(int argc, char** argv) {
     }
   }
   if (!plot_path.empty()) {
-    const int status = run_program({"/usr/bin/python3", plot_script(), csv_path, "--out", plot_path,
-                                    "--settle-s", fmt::format("{}", scenario.settle_s)});
+    const int status = run_program({"/usr/bin/python3", plot_script(scenario), csv_path, "--out",
+                                    plot_path, "--settle-s", fmt::format("{}", scenario.settle_s)});
     if (temporary_csv) std::filesystem::remove(csv_path);
     if (status != 0) {
-      std::cerr << "drive_sim: plotting failed (tools/plot_seed000.py, status " << status
+      std::cerr << "drive_sim: plotting failed (" << plot_script(scenario) << ", status " << status
                 << "; it needs python3-matplotlib)\n";
       return kExitOutputFailed;
     }

@@ -227,6 +227,9 @@ Summary run(const Scenario& s, const RunCallbacks& callbacks) {
   if (measured == 0) {
     summary.speed_max_err_rad_s = summary.flux2_max_err_Wb2 = summary.i_peak_A = std::nan("");
   }
+  if (iol && !s.outer_speed_loop) {  // a torque-controlled run has no speed reference
+    summary.speed_rms_err_rad_s = summary.speed_max_err_rad_s = std::nan("");
+  }
   summary.torque_rms_err_Nm =
       torque_count > 0 ? std::sqrt(torque_sq / double(torque_count)) : std::nan("");
   summary.tick_exec_ns_mean = drive.execution().mean_ns();
