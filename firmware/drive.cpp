@@ -35,6 +35,7 @@ Drive<T>::Drive(const control::MotorParameters& motor, const DriveConfig& config
       load_estimator_(coefficients_,
                       control::place_load_estimator(coefficients_, config.load_estimator_pole,
                                                     config.load_estimator_pole)),
+      current_loop_(coefficients_),
       speed_ramp_(config.max_accel_rad_s2, config.sample_period_s),
       iol_stage_(motor, config) {
   const control::Seed000Constants k = control::derive_seed000(motor);
@@ -159,14 +160,6 @@ control::InputDisk<T> Drive<T>::feasible_inputs(const control::RotorFrameState<T
 }
 
 template <typename T>
-control::Vec2<T> Drive<T>::current_input(const control::RotorFrameState<T>& x,
-                                         const Vec2& i_target_AB_A,
-                                         const control::InputDisk<T>& feasible) const noexcept {
-  const Vec2 v = (i_target_AB_A - a21_ * x.flux_r_AB_Wb - a22_ * x.i_s_AB_A) / b2_;
-  return feasible.clamp(v);
-}
-
-template <typename T>
 control::Vec2<T> Drive<T>::magnetizing_current(const control::RotorFrameState<T>& x,
                                                const Reference& ref) const noexcept {
   // Steady state at zero slip: Phi_r = Lm I and phi_s = Ls I.
@@ -250,7 +243,7 @@ void Drive<T>::on_tick() noexcept {
         trip(FaultCode::magnetizing_timeout);
       } else {
         i_command = magnetizing_current(x, ref);
-        v = current_input(x, i_command, feasible);
+        v = current_loop_.input(x.flux_r_AB_Wb, x.i_s_AB_A, i_command, feasible);
       }
     }
     if (state_ == DriveState::running && config_.controller == ControllerKind::iol) {
@@ -260,7 +253,7 @@ void Drive<T>::on_tick() noexcept {
           iol_stage_.tick(e.x.flux_r_AB_Wb, e.x.omega_mech_rad_s, boundary_ref);
       if (r.status != control::IolStatus::ok) trip(FaultCode::singular_control);
       i_command = r.i_cmd_AB_A;
-      v = current_input(x, i_command, feasible);
+      v = current_loop_.input(x.flux_r_AB_Wb, x.i_s_AB_A, i_command, feasible);
       record_.iol_boundary = r.boundary;
       if (r.boundary) {
         record_.torque_ref_Nm = double(r.torque_ref_Nm);

@@ -8,6 +8,7 @@
 /// T is the control arithmetic: float on the MCU, double on the host.
 #include <cstdint>
 
+#include "control/deadbeat_current.hpp"
 #include "control/dsmc.hpp"
 #include "control/encoder_observer.hpp"
 #include "control/exact_model_000.hpp"
@@ -66,10 +67,6 @@ class Drive final : public hal::TickHandler {
   Estimate estimate(const hal::AdcSample& sample) noexcept;
   control::InputDisk<T> feasible_inputs(const control::RotorFrameState<T>& x,
                                         T v_bus_V) const noexcept;
-  /// Deadbeat current control on the exact model: the v~ that brings I~ to the target at the
-  /// next step, clamped to the feasible inputs.
-  Vec2 current_input(const control::RotorFrameState<T>& x, const Vec2& i_target_AB_A,
-                     const control::InputDisk<T>& feasible) const noexcept;
   /// The magnetizing current: along the flux (the A axis while there is none), of the size that
   /// holds the reference flux in steady state (rotor flux for the DSMC, stator flux for the IOL).
   Vec2 magnetizing_current(const control::RotorFrameState<T>& x,
@@ -91,6 +88,7 @@ class Drive final : public hal::TickHandler {
   control::FluxObserver<T> flux_observer_;
   control::EncoderObserver<T> encoder_observer_;
   control::LoadEstimator<T> load_estimator_;
+  control::DeadbeatCurrent<T> current_loop_;
   SpeedRamp<T> speed_ramp_;
   IolStage<T> iol_stage_;
   T sigma_H_, beta_per_H_, pole_pairs_, Lm_H_, Ls_H_, Lm_over_Lr_, a21_, a22_, b2_;

@@ -4,8 +4,8 @@ set -eu
 cd "$(dirname "$0")/.."
 tools/install_deps.sh
 cmake --preset host >/dev/null
-cmake --build --preset host --target bench_plant bench_drive
-for bench in bench_plant bench_drive; do
+cmake --build --preset host --target bench_plant bench_drive bench_control
+for bench in bench_plant bench_drive bench_control; do
   build/bin/$bench --benchmark_repetitions=5 --benchmark_report_aggregates_only=true \
     --benchmark_min_time=0.2 "$@"
 done
