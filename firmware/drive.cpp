@@ -247,8 +247,9 @@ void Drive<T>::on_tick() noexcept {
       }
     }
     if (state_ == DriveState::running && config_.controller == ControllerKind::iol) {
-      const Reference boundary_ref =
+      Reference boundary_ref =
           references_.at_tick(k + uint64_t(iol_stage_.ticks_per_period()));
+      boundary_ref.omega_mech_rad_s = ref.omega_mech_rad_s;  // through the speed ramp
       const IolTickResult<T> r =
           iol_stage_.tick(e.x.flux_r_AB_Wb, e.x.omega_mech_rad_s, boundary_ref);
       if (r.status != control::IolStatus::ok) trip(FaultCode::singular_control);

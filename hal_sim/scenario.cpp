@@ -286,6 +286,7 @@ Scenario load_scenario(const std::filesystem::path& path,
   s.torque_limit_Nm = r.positive("drive.torque_limit_Nm", 240.0);
   s.flux_loop_time_constant_s = r.positive("drive.flux_loop_time_constant_s", 0.01);
   s.magnetized_fraction = r.number("drive.magnetized_fraction", 0.95);
+  s.magnetizing_current_A = r.non_negative("drive.magnetizing_current_A", 0.0);
   if (!(s.magnetized_fraction > 0.0 && s.magnetized_fraction <= 1.0)) {
     r.fail("drive.magnetized_fraction",
            fmt::format("= {}: must be in (0, 1]", s.magnetized_fraction));

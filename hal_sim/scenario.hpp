@@ -45,6 +45,7 @@ struct Scenario {
   double speed_loop_bandwidth_rad_s = 30.0, torque_limit_Nm = 240.0;
   double flux_loop_time_constant_s = 0.01;
   double magnetized_fraction = 0.95;
+  double magnetizing_current_A = 0.0;  ///< 0: the current that holds the flux target
 
   LoadProfile load;
 

@@ -90,5 +90,35 @@ TEST(Seed001OuterLoop, FluxLoopRemovesTheSlipExcess) {
   EXPECT_LE(peak, 1.15 * s.stator_flux2_Wb2);
 }
 
+TEST(Seed001Realistic, TracksTorqueAndHoldsTheFluxOnAVoltageInverter) {
+  const Scenario s = scenario("seed001_realistic.toml");
+  double flux_dev_speed_step = 0.0, flux_dev_load_step = 0.0;
+  const Summary r = run_scenario(s, {[&](const SimRow& row) {
+                                       const double dev =
+                                           std::abs(row.stator_flux2_Wb2 - s.stator_flux2_Wb2);
+                                       if (row.t_s >= 0.6 && row.t_s < 1.0)
+                                         flux_dev_speed_step = std::max(flux_dev_speed_step, dev);
+                                       if (row.t_s >= 1.6 && row.t_s < 2.0)
+                                         flux_dev_load_step = std::max(flux_dev_load_step, dev);
+                                     },
+                                     {}});
+  ASSERT_TRUE(r.faults.empty());
+  std::printf(
+      "seed001 realistic: torque rms err %.3f N m, flux dev %.4f / %.4f, speed rms %.4f rad/s, "
+      "i hold rms %.3f A, i peak %.1f A\n",
+      r.torque_rms_err_Nm, flux_dev_speed_step, flux_dev_load_step, r.speed_rms_err_rad_s,
+      r.i_hold_rms_err_A, r.i_peak_total_A);
+  // Torque against the law's command one T0 earlier, after 2 s: <= 2 % of the 100 N m load step.
+  EXPECT_LE(r.torque_rms_err_Nm, 0.02 * 100.0);
+  // The squared stator flux moves by <= 1 % at the torque demand of the speed step and at the
+  // load step (the coupling the decoupling leaves on a real board).
+  EXPECT_LE(flux_dev_speed_step, 0.01 * s.stator_flux2_Wb2);
+  EXPECT_LE(flux_dev_load_step, 0.01 * s.stator_flux2_Wb2);
+  EXPECT_LE(r.i_peak_total_A, s.i_max_A);
+  // The speed error after 2 s, documented in docs/iol.md (measured 0.046 rad/s RMS); 3x room
+  // for the noise.
+  EXPECT_LE(r.speed_rms_err_rad_s, 0.15);
+}
+
 }  // namespace
 }  // namespace imd::sim

@@ -72,6 +72,7 @@ const Column kColumns[] = {
     IMD_COLUMN(y2_ref),
     IMD_COLUMN(stator_flux2_Wb2),
     IMD_COLUMN(stator_flux2_ref_Wb2),
+    IMD_COLUMN(i_hold_err_A),
     IMD_COLUMN(iol_boundary),
     IMD_COLUMN(state),
     IMD_COLUMN(saturated),
@@ -91,6 +92,7 @@ nlohmann::ordered_json summary_json(const imd::sim::Scenario& s, const imd::sim:
           {"flux2_max_err_Wb2", r.flux2_max_err_Wb2},
           {"load_est_rms_err_Nm", r.load_est_rms_err_Nm},
           {"torque_rms_err_Nm", r.torque_rms_err_Nm},
+          {"i_hold_rms_err_A", r.i_hold_rms_err_A},
           {"i_peak_A", r.i_peak_A},
           {"i_peak_total_A", r.i_peak_total_A},
           {"i_max_A", std::isfinite(s.i_max_A) ? nlohmann::ordered_json(s.i_max_A)

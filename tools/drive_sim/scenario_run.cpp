@@ -68,6 +68,7 @@ firmware::DriveConfig drive_config(const Scenario& s) {
   c.torque_limit_Nm = s.torque_limit_Nm;
   c.flux_loop_time_constant_s = s.flux_loop_time_constant_s;
   c.magnetized_fraction = s.magnetized_fraction;
+  c.magnetizing_current_A = s.magnetizing_current_A;
   c.analog_inner_loop = s.inner_feedback == InnerFeedback::ideal_analog;
   c.pwm_latency_ticks = s.pwm_latency_ticks;
   c.compensate_latency = s.compensate_latency;
@@ -80,6 +81,7 @@ firmware::DriveConfig drive_config(const Scenario& s) {
   c.bus_min_V = 0.7 * s.v_bus_V;  // +-30 % of the nominal bus
   c.bus_max_V = 1.3 * s.v_bus_V;
   c.adc_calibration_ticks = s.ideal_sensors ? 0 : 256;
+  c.adc_offset_limit_A = 0.02 * s.adc.full_scale_A;  // 2 % of full scale (0.2 A on 10 A)
   c.section_iv_load_estimator = s.section_iv;
   c.encoder_observer_bandwidth_rad_s = s.encoder_bandwidth_rad_s;
   c.load_estimator_pole = s.load_estimator_pole;
@@ -114,6 +116,8 @@ Summary run(const Scenario& s, const RunCallbacks& callbacks) {
   const control::MotorParameters& m = s.motor;
   double speed_sq = 0, flux_sq = 0, load_sq = 0, torque_sq = 0;
   uint64_t torque_count = 0;
+  double hold_sq = 0;
+  uint64_t hold_count = 0;
   const bool iol = s.controller == "iol";
   const double flux_decay = control::discretize_seed001(m, s.iol_period_s).flux_decay;
   Vec2 boundary_flux_s = Vec2::Zero();       // true stator flux (rotor frame) at the last boundary
@@ -176,6 +180,16 @@ Summary run(const Scenario& s, const RunCallbacks& callbacks) {
         held.torque_ref_Nm = rec.torque_ref_Nm;
         held.y2_ref = rec.y2_ref;
       }
+      // How far the stator current departs from the rotor-frame zero-order hold paper 001
+      // assumes (the command of this tick).
+      const Vec2 i_AB = rotor.apply_inverse(truth.i_s_alphabeta_A);
+      row.i_hold_err_A = iol && rec.state == firmware::DriveState::running
+                             ? (i_AB - Vec2(rec.i_cmd_A_A, rec.i_cmd_B_A)).norm()
+                             : 0.0;
+      if (iol && t_s > s.settle_s) {
+        hold_sq += row.i_hold_err_A * row.i_hold_err_A;
+        ++hold_count;
+      }
       row.y2 = held.y2;
       row.y2_ref = held.y2_ref;
       row.torque_ref_Nm = held.torque_ref_Nm;
@@ -230,6 +244,8 @@ Summary run(const Scenario& s, const RunCallbacks& callbacks) {
   if (iol && !s.outer_speed_loop) {  // a torque-controlled run has no speed reference
     summary.speed_rms_err_rad_s = summary.speed_max_err_rad_s = std::nan("");
   }
+  summary.i_hold_rms_err_A =
+      hold_count > 0 ? std::sqrt(hold_sq / double(hold_count)) : std::nan("");
   summary.torque_rms_err_Nm =
       torque_count > 0 ? std::sqrt(torque_sq / double(torque_count)) : std::nan("");
   summary.tick_exec_ns_mean = drive.execution().mean_ns();

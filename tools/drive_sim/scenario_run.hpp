@@ -25,6 +25,7 @@ struct SimRow {
   // The current-fed controller (iol): at T0 boundaries (iol_boundary), else held.
   double torque_ref_Nm = 0.0, y2 = 0.0, y2_ref = 0.0, stator_flux2_Wb2 = 0.0;
   double stator_flux2_ref_Wb2 = 0.0;
+  double i_hold_err_A = 0.0;  ///< |i_AB - i_cmd|: departure from the zero-order hold (iol)
   bool iol_boundary = false;
   int state = 0;
   bool saturated = false;
@@ -42,6 +43,7 @@ struct Summary {
   double flux2_rms_err_Wb2 = 0.0, flux2_max_err_Wb2 = 0.0;
   double load_est_rms_err_Nm = 0.0;
   double torque_rms_err_Nm = 0.0;  ///< iol: torque against the law's command one T0 earlier
+  double i_hold_rms_err_A = 0.0;   ///< iol: RMS of |i_AB - i_cmd| over the ticks
   double i_peak_A = 0.0, i_peak_total_A = 0.0;
   double saturated_fraction = 0.0;
   uint64_t ticks = 0;
