@@ -13,7 +13,9 @@
 /// for aligned fluxes, so a large v2 at a small flux multiplies the flux (from F = 0.01 Wb^2 a
 /// linear v2 of 0.19 gives F = 4 Wb^2). The loop therefore takes the F(k+1) its linear design
 /// intends, F_i = e F + v2_lin, and sends the v2 that gives it exactly,
-/// v2 = sqrt(F) sqrt(F_i) - e F; at equilibrium the two are the same.
+/// v2 = sqrt(F) sqrt(F_i) - e F; at equilibrium the two are the same. F_i is floored at e^2 F
+/// (the flux may shrink by e per period, as with no current): v2 >= 0 then, and the law's
+/// flux-only command never points the stator flux away from the rotor flux.
 /// Tick context except the constructor.
 #include <cmath>
 
@@ -43,9 +45,10 @@ class FluxOuterLoop {
     const T error = flux2_ref_Wb2 - flux2_Wb2;
     const T v2_linear = (T(1) - e_) * flux2_ref_Wb2 + kp_ * error + integral_;
     integral_ += ki_ * error;
-    const T intended = e_ * flux2_Wb2 + v2_linear;  // F(k+1) of the linear design
     const T flux2 = flux2_Wb2 > T(0) ? flux2_Wb2 : T(0);
-    return sqrt(flux2) * sqrt(intended > T(0) ? intended : T(0)) - e_ * flux2;
+    const T floor = e_ * e_ * flux2;
+    const T intended = e_ * flux2 + v2_linear;  // F(k+1) of the linear design
+    return sqrt(flux2) * sqrt(intended > floor ? intended : floor) - e_ * flux2;
   }
   void reset() noexcept { integral_ = T(0); }
 

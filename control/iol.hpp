@@ -13,7 +13,8 @@
 /// and phi_r must not become orthogonal. Following the paper's suggestion the torque command
 /// v1 is saturated dynamically: the largest |v1| <= |v1_ref| is used for which the exactly
 /// predicted fluxes of step k+1 stay within max_angle of each other. A state whose own B_k is
-/// (nearly) singular is refused: the current is held. Tick context; no division by zero.
+/// (nearly) singular, a flux command that breaks the guard even without torque, and non-finite
+/// inputs are refused: the current is held. Tick context; no division by zero.
 #include <cmath>
 
 #include "control/exact_model_001.hpp"
@@ -80,7 +81,9 @@ class Iol {
     const Vec2<T> flux_r = modified_rotor_flux(flux, in.i_s_AB_A);
     out.det_B = -k_np_ * ls_sigma_ * flux.dot(flux_r);
     if (!aligned_enough(flux, flux_r, cos_refuse_) || !(flux.norm() >= min_flux_)) return out;
-    out.status = IolStatus::ok;
+    if (!std::isfinite(in.torque_ref_Nm) || !std::isfinite(in.y2_ref) || !in.i_s_AB_A.allFinite()) {
+      return out;
+    }
 
     const T a = c_ * flux.dot(in.i_s_AB_A);
     const auto law = [&](T v1) {  // (24): u = B^-1 [v1; v2 - a]
@@ -97,6 +100,11 @@ class Iol {
       return aligned_enough(flux_next, flux_r_next, cos_max_);
     };
 
+    // The flux-only command (v1 = 0) must itself keep B invertible; if the flux command alone
+    // turns the stator flux away from phi_r (v2 <= -e F), no torque saturation can help.
+    T det_flux_only;
+    if (!next_fluxes_ok(law(T(0)), &det_flux_only)) return out;
+    out.status = IolStatus::ok;
     Vec2<T> u = law(in.torque_ref_Nm);
     out.torque_cmd_Nm = in.torque_ref_Nm;
     if (!next_fluxes_ok(u, &out.det_B_next)) {

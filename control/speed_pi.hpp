@@ -1,7 +1,8 @@
 #pragma once
 /// Discrete PI speed controller producing a torque reference, with a torque limit and
 /// anti-windup by conditional integration: the integrator does not grow while the output is
-/// saturated in the direction the error pushes. Tick context except the constructor.
+/// saturated in the direction the error pushes, nor when a later stage reports that the torque
+/// was trimmed (undo_last_integration). Tick context except the constructor.
 #include <algorithm>
 
 namespace imd::control {
@@ -36,16 +37,25 @@ class SpeedPi {
     const T output = std::clamp(unclamped, -limit_, limit_);
     const bool pushing_further =
         (unclamped > limit_ && error > T(0)) || (unclamped < -limit_ && error < T(0));
+    const T before = integral_;
     if (!pushing_further) integral_ = std::clamp(integral_ + ki_T0_ * error, -limit_, limit_);
+    last_increment_ = integral_ - before;
     saturated_ = output != unclamped;
     return output;
   }
   bool saturated() const noexcept { return saturated_; }
+  /// The torque asked for was not delivered (trimmed downstream): take back this step's
+  /// integration so that the integrator does not wind up against that limit either.
+  void undo_last_integration() noexcept {
+    integral_ -= last_increment_;
+    last_increment_ = T(0);
+  }
   void reset(T integral_Nm = T(0)) noexcept { integral_ = integral_Nm; }
 
  private:
   T kp_, ki_T0_, limit_;
   T integral_ = T(0);
+  T last_increment_ = T(0);
   bool saturated_ = false;
 };
 

@@ -247,13 +247,14 @@ void Drive<T>::on_tick() noexcept {
       }
     }
     if (state_ == DriveState::running && config_.controller == ControllerKind::iol) {
-      Reference boundary_ref =
-          references_.at_tick(k + uint64_t(iol_stage_.ticks_per_period()));
+      Reference boundary_ref = references_.at_tick(k + uint64_t(iol_stage_.ticks_per_period()));
       boundary_ref.omega_mech_rad_s = ref.omega_mech_rad_s;  // through the speed ramp
       const IolTickResult<T> r =
           iol_stage_.tick(e.x.flux_r_AB_Wb, e.x.omega_mech_rad_s, boundary_ref);
       if (r.status != control::IolStatus::ok) trip(FaultCode::singular_control);
       i_command = r.i_cmd_AB_A;
+      record_.i_held_A_A = double(r.i_held_AB_A.x());
+      record_.i_held_B_A = double(r.i_held_AB_A.y());
       v = current_loop_.input(x.flux_r_AB_Wb, x.i_s_AB_A, i_command, feasible);
       record_.iol_boundary = r.boundary;
       if (r.boundary) {

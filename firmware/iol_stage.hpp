@@ -21,8 +21,9 @@ namespace imd::firmware {
 
 template <typename T>
 struct IolTickResult {
-  control::Vec2<T> i_cmd_AB_A = control::Vec2<T>::Zero();  ///< current to impose this tick
-  bool boundary = false;                                   ///< the law ran this tick
+  control::Vec2<T> i_cmd_AB_A = control::Vec2<T>::Zero();   ///< current to command this tick
+  control::Vec2<T> i_held_AB_A = control::Vec2<T>::Zero();  ///< current the law assumes now
+  bool boundary = false;                                    ///< the law ran this tick
   control::IolStatus status = control::IolStatus::ok;
   T torque_ref_Nm = T(0), torque_cmd_Nm = T(0);  ///< v1 before and after the guard
   T y2_ref = T(0), y2 = T(0);                    ///< v2, and y2(k) from the flux estimates
@@ -43,6 +44,7 @@ class IolStage {
                                            config.torque_limit_Nm, config.iol_period_s)),
         ticks_per_period_(
             static_cast<int>(std::lround(config.iol_period_s / config.sample_period_s))),
+        lead_ticks_((config.current_source ? 0 : 1) + config.pwm_latency_ticks),
         outer_speed_loop_(config.outer_speed_loop),
         outer_flux_loop_(config.outer_flux_loop),
         sigma_H_(T(motor.Ls_H - motor.Lm_H * motor.Lm_H / motor.Lr_H)),
@@ -71,7 +73,12 @@ class IolStage {
       i_held_ = i_next_;
       r.boundary = true;
     }
-    r.i_cmd_AB_A = i_held_;
+    // u(k) is known a whole period ahead: it is commanded early enough for the current to be
+    // there at the next boundary, 1 + latency ticks early for the deadbeat current loop (which
+    // reaches its target one tick after it acts), latency ticks for an ideal current source.
+    const auto phase = int((ticks_ - 1) % uint64_t(ticks_per_period_));
+    r.i_held_AB_A = i_held_;
+    r.i_cmd_AB_A = (!r.boundary && ticks_per_period_ - phase <= lead_ticks_) ? i_next_ : i_held_;
     if (!r.boundary) return r;
     // The stator flux just after the current stepped to the held value (15).
     const control::Vec2<T> flux_s = sigma_H_ * i_held_ + Lm_over_Lr_ * flux_r_AB_Wb;
@@ -88,6 +95,7 @@ class IolStage {
     r.status = out.status;
     r.torque_cmd_Nm = out.torque_cmd_Nm;
     r.torque_limited = out.torque_limited;
+    if (out.torque_limited && outer_speed_loop_) speed_pi_.undo_last_integration();
     i_next_ = out.i_next_AB_A;
     return r;
   }
@@ -98,6 +106,7 @@ class IolStage {
   control::FluxOuterLoop<T> flux_loop_;
   control::SpeedPi<T> speed_pi_;
   int ticks_per_period_;
+  int lead_ticks_;  ///< ticks before a boundary at which u(k) is commanded
   bool outer_speed_loop_, outer_flux_loop_;
   T sigma_H_, Lm_over_Lr_;
   control::Vec2<T> i_held_ = control::Vec2<T>::Zero();  ///< imposed over this period, u(k-1)

@@ -61,7 +61,8 @@ struct TickRecord {
   // The current-fed controller (iol), at its last T0 boundary.
   double torque_ref_Nm = 0.0, torque_cmd_Nm = 0.0, y2 = 0.0, y2_ref = 0.0;
   double stator_flux2_est_Wb2 = 0.0;
-  double i_cmd_A_A = 0.0, i_cmd_B_A = 0.0;  ///< rotor-frame current command
+  double i_cmd_A_A = 0.0, i_cmd_B_A = 0.0;    ///< rotor-frame current command
+  double i_held_A_A = 0.0, i_held_B_A = 0.0;  ///< iol: the current the law assumes held now
   bool torque_limited = false;
   bool iol_boundary = false;  ///< the IOL law ran this tick
   bool speed_saturated = false, flux_saturated = false, voltage_clipped = false;

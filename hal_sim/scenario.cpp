@@ -285,11 +285,15 @@ Scenario load_scenario(const std::filesystem::path& path,
   s.speed_loop_bandwidth_rad_s = r.positive("drive.speed_loop_bandwidth_rad_s", 30.0);
   s.torque_limit_Nm = r.positive("drive.torque_limit_Nm", 240.0);
   s.flux_loop_time_constant_s = r.positive("drive.flux_loop_time_constant_s", 0.01);
+  if (s.flux_loop_time_constant_s < 2.0 * s.iol_period_s) {  // keeps Kp below e (docs/iol.md)
+    r.fail("drive.flux_loop_time_constant_s",
+           fmt::format("= {}: must be >= 2 drive.iol_period_s", s.flux_loop_time_constant_s));
+  }
   s.magnetized_fraction = r.number("drive.magnetized_fraction", 0.95);
   s.magnetizing_current_A = r.non_negative("drive.magnetizing_current_A", 0.0);
-  if (!(s.magnetized_fraction > 0.0 && s.magnetized_fraction <= 1.0)) {
+  if (!(s.magnetized_fraction > 0.0 && s.magnetized_fraction < 1.0)) {
     r.fail("drive.magnetized_fraction",
-           fmt::format("= {}: must be in (0, 1]", s.magnetized_fraction));
+           fmt::format("= {}: must be in (0, 1)", s.magnetized_fraction));
   }
   s.precision = r.choice("drive.precision", "double", {"double", "float"});
   s.max_accel_rad_s2 = r.positive_or_inf("drive.max_accel_rad_s2");

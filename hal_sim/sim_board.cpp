@@ -44,6 +44,7 @@ void SimBoard::run_tick() {
   }
   start_torque_Nm_ = plant_.torque_Nm(current_now, now.flux_r_alphabeta_Wb);
   start_flux_s_alphabeta_Wb_ = plant_.flux_s_alphabeta_Wb(current_now);
+  start_current_alphabeta_A_ = current_now;
 
   if (!pwm_.enabled()) {
     applied_voltage_V_.setZero();

@@ -65,6 +65,7 @@ class SimBoard {
   /// (after the step a current source makes at the period's start).
   double start_torque_Nm() const noexcept { return start_torque_Nm_; }
   const Vec2& start_flux_s_alphabeta_Wb() const noexcept { return start_flux_s_alphabeta_Wb_; }
+  const Vec2& start_current_alphabeta_A() const noexcept { return start_current_alphabeta_A_; }
 
   void run_tick();
 
@@ -88,6 +89,7 @@ class SimBoard {
   Vec2 active_current_AB_A_ = Vec2::Zero();
   double start_torque_Nm_ = 0.0;
   Vec2 start_flux_s_alphabeta_Wb_ = Vec2::Zero();
+  Vec2 start_current_alphabeta_A_ = Vec2::Zero();
   Vec2 applied_voltage_V_ = Vec2::Zero();
 };
 

@@ -47,6 +47,14 @@ TEST(Seed001Paper, DecouplesExactlyAndSettlesTheFlux) {
   std::printf("seed001 paper: worst relative error torque %.2e, y2 %.2e\n", worst_torque, worst_y2);
   EXPECT_LE(worst_torque, 1e-9);
   EXPECT_LE(worst_y2, 1e-9);
+  // The references reach the law at the right tick: v1 is the torque wanted at the next
+  // boundary, so the torque is 120 N m from the first boundary at or after 1 s, 0 before.
+  for (std::size_t k = 1; k < boundaries.size(); ++k) {
+    if (boundaries[k].t_s >= 1.0 && boundaries[k - 1].t_s < 1.0) {
+      EXPECT_NEAR(boundaries[k].torque_Nm, 120.0, 1e-9 * 120.0);
+      EXPECT_NEAR(boundaries[k - 1].torque_Nm, 0.0, 1e-9);
+    }
+  }
 
   // The squared stator flux settles within 1 % of the target set through (21)...
   const SimRow& last = boundaries.back();
@@ -68,6 +76,25 @@ TEST(Seed001Paper, DecouplesExactlyAndSettlesTheFlux) {
               last.stator_flux2_Wb2, s.stator_flux2_Wb2, slip_T0 / s.iol_period_s, predicted);
 }
 
+TEST(Seed001Paper, MetricsAndStartUpAreRight) {
+  // The summary's torque error spans the torque step when settle_s precedes it: it compares
+  // each boundary with the command of the one before, so it stays at rounding level.
+  const Summary r = run_scenario(scenario("seed001_paper.toml", {"metrics.settle_s=0.5"}));
+  EXPECT_LE(r.torque_rms_err_Nm, 1e-9 * 120.0);
+  EXPECT_LE(r.i_hold_rms_err_A, 1e-9);  // the ideal source holds the current exactly
+  // The default magnetizing current of the iol is the one that holds the stator-flux target at
+  // zero slip, sqrt(F)/Ls = 31.50 A for the 37 kW motor; an ideal source imposes it exactly.
+  const Scenario s = scenario("seed001_paper.toml", {"drive.magnetized_fraction=0.5"});
+  double magnetizing_current = 0.0;
+  run_scenario(s, {[&](const SimRow& row) {
+                     if (row.state == 1 && row.t_s > 0.01) {
+                       magnetizing_current = std::hypot(row.i_alpha_A, row.i_beta_A);
+                     }
+                   },
+                   {}});
+  EXPECT_NEAR(magnetizing_current, std::sqrt(s.stator_flux2_Wb2) / s.motor.Ls_H, 1e-9);
+}
+
 TEST(Seed001OuterLoop, FluxLoopRemovesTheSlipExcess) {
   // With the loop of Fig. 5 the squared stator flux sits on its target at the boundaries despite
   // the slip (the integrator takes up what (21) neglects); decoupling is unchanged.
@@ -83,6 +110,10 @@ TEST(Seed001OuterLoop, FluxLoopRemovesTheSlipExcess) {
   // nothing measurable after 1.4 s: the excess of the open loop (2e-3) is gone to 1e-6.
   EXPECT_NEAR(boundaries.back().stator_flux2_Wb2, s.stator_flux2_Wb2, 1e-6);
   EXPECT_LE(r.torque_rms_err_Nm, 1e-9 * 120.0);
+  // With one tick of latency the current source gets u(k) one tick early: decoupling holds.
+  const Summary late =
+      run_scenario(scenario("seed001_outer_loop.toml", {"simulation.pwm_latency_ticks=1"}));
+  EXPECT_LE(late.torque_rms_err_Nm, 1e-9 * 120.0);
   // The loop inverts the magnitude relation of y2, so the start from 1 % of the flux does not
   // overshoot wildly (a linear v2 would reach 4 Wb^2, 400 %): measured 10.8 %.
   double peak = 0.0;
@@ -108,7 +139,8 @@ TEST(Seed001Realistic, TracksTorqueAndHoldsTheFluxOnAVoltageInverter) {
       "i hold rms %.3f A, i peak %.1f A\n",
       r.torque_rms_err_Nm, flux_dev_speed_step, flux_dev_load_step, r.speed_rms_err_rad_s,
       r.i_hold_rms_err_A, r.i_peak_total_A);
-  // Torque against the law's command one T0 earlier, after 2 s: <= 2 % of the 100 N m load step.
+  // Torque against the law's command one T0 earlier, after 2 s: <= 2 % of the 100 N m load step
+  // (measured 1.16 N m; with ideal sensors 1e-3 N m: the ADC and encoder noise make the rest).
   EXPECT_LE(r.torque_rms_err_Nm, 0.02 * 100.0);
   // The squared stator flux moves by <= 1 % at the torque demand of the speed step and at the
   // load step (the coupling the decoupling leaves on a real board).

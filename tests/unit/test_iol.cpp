@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <random>
 
@@ -111,6 +112,28 @@ TEST_F(IolTest, NearlySingularStateIsRefusedWithoutDivision) {
     EXPECT_EQ(out.status, IolStatus::singular);
     EXPECT_EQ(out.i_next_AB_A, in.i_s_AB_A);
   }
+}
+
+TEST_F(IolTest, AFluxCommandThatBreaksTheGuardByItselfIsRefused) {
+  // v2 <= -e F asks for a stator flux at k+1 pointing away from phi_r(k) whatever the torque:
+  // no saturation of v1 can keep det B(k+1) < 0, so the law refuses (and holds the current).
+  IolInput<double> in;
+  in.flux_s_AB_Wb = {0.9, 0.0};
+  in.i_s_AB_A = in.flux_s_AB_Wb / motor.Ls_H;  // the magnetized state at zero slip
+  in.torque_ref_Nm = 50.0;
+  in.y2_ref = -0.9;
+  const IolOutput<double> out = iol.step(in);
+  EXPECT_EQ(out.status, IolStatus::singular);
+  EXPECT_EQ(out.i_next_AB_A, in.i_s_AB_A);
+  // Non-finite commands are refused too, instead of returning a NaN current.
+  in.y2_ref = 0.002;
+  in.torque_ref_Nm = std::nan("");
+  EXPECT_EQ(iol.step(in).status, IolStatus::singular);
+  in.torque_ref_Nm = 50.0;
+  in.y2_ref = std::numeric_limits<double>::infinity();
+  EXPECT_EQ(iol.step(in).status, IolStatus::singular);
+  in.y2_ref = 0.002;
+  EXPECT_EQ(iol.step(in).status, IolStatus::ok);
 }
 
 }  // namespace

@@ -3,6 +3,7 @@
 
 #include <Eigen/Eigenvalues>
 #include <cmath>
+#include <vector>
 
 #include "control/exact_model_001.hpp"
 #include "control/flux_outer_loop.hpp"
@@ -53,13 +54,41 @@ TEST(FluxOuterLoop, RemovesTheSteadyStateErrorOfEquation21) {
 
 TEST(SpeedPi, LimitsTorqueAndDoesNotWindUp) {
   SpeedPi<double> pi(design_speed_pi(0.41, 50.0, 240.0, 1e-3));
-  // A large error saturates at the limit and the integrator stays bounded.
+  // A large error saturates at the limit; the integrator does not grow meanwhile.
   for (int k = 0; k < 5000; ++k) EXPECT_LE(std::abs(pi.step(100.0, 0.0)), 240.0);
   EXPECT_TRUE(pi.saturated());
-  // When the error reverses, the output leaves the limit at once (no wound-up integral).
+  // When the error reverses, the output is the proportional part alone: Kp * (-1) = -20.5 N m.
+  // A wound-up integral (up to the 240 N m clamp) would keep it near +219 N m.
   const double after = pi.step(0.0, 1.0);
-  EXPECT_LT(after, 240.0);
+  EXPECT_NEAR(after, -0.41 * 50.0 * 1.0, 0.1);
   EXPECT_FALSE(pi.saturated());
+}
+
+TEST(SpeedPi, UndoTakesBackTheLastIntegration) {
+  // A later stage trimmed the torque: the step's integration is taken back.
+  SpeedPi<double> pi(design_speed_pi(0.41, 50.0, 240.0, 1e-3));
+  const double first = pi.step(1.0, 0.0);  // Kp e + 0 (the integral is used before it grows)
+  pi.undo_last_integration();
+  EXPECT_DOUBLE_EQ(pi.step(1.0, 0.0), first);  // the same: nothing was integrated
+  const double third = pi.step(1.0, 0.0);
+  EXPECT_GT(third, first);  // without the undo the integral grows
+}
+
+TEST(FluxOuterLoop, StepRealisesTheDesignedClosedLoop) {
+  // Drive step() on the magnitude relation it inverts (aligned fluxes, no slip): the error must
+  // obey the double-pole recurrence e(k+2) - 2 z e(k+1) + z^2 e(k) = 0, z = exp(-T0/tau).
+  const double e = 0.9978351639822989, z = std::exp(-0.1);
+  FluxOuterLoop<double> loop(e, place_flux_outer_loop(e, 1e-3, 0.01));
+  double flux = std::sqrt(0.97);
+  std::vector<double> error;
+  for (int k = 0; k < 40; ++k) {
+    error.push_back(1.0 - flux * flux);
+    flux = next_flux(flux, loop.step(1.0, flux * flux), e, 0.0);
+  }
+  for (int k = 5; k + 2 < 40; ++k) {
+    EXPECT_NEAR(error[k + 2] - 2 * z * error[k + 1] + z * z * error[k], 0.0, 1e-12) << k;
+  }
+  EXPECT_LT(std::abs(error.back()), 0.03 * 0.1);  // decayed by (1 + 39 * 0.1) z^39 ~ 0.1
 }
 
 TEST(SpeedPi, ClosedLoopOnTheExactSpeedModelRejectsALoadStep) {

@@ -181,10 +181,11 @@ Summary run(const Scenario& s, const RunCallbacks& callbacks) {
         held.y2_ref = rec.y2_ref;
       }
       // How far the stator current departs from the rotor-frame zero-order hold paper 001
-      // assumes (the command of this tick).
-      const Vec2 i_AB = rotor.apply_inverse(truth.i_s_alphabeta_A);
+      // assumes: the current at the start of the period (after any step) against the current
+      // the law takes as held over it.
+      const Vec2 i_AB = rotor.apply_inverse(board.start_current_alphabeta_A());
       row.i_hold_err_A = iol && rec.state == firmware::DriveState::running
-                             ? (i_AB - Vec2(rec.i_cmd_A_A, rec.i_cmd_B_A)).norm()
+                             ? (i_AB - Vec2(rec.i_held_A_A, rec.i_held_B_A)).norm()
                              : 0.0;
       if (iol && t_s > s.settle_s) {
         hold_sq += row.i_hold_err_A * row.i_hold_err_A;
