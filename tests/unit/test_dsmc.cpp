@@ -124,6 +124,8 @@ TEST_F(DsmcTest, OffCentreDiskBoundsTheInputExactly) {
     const auto out = dsmc.step(in);
     ASSERT_EQ(out.status, DsmcStatus::ok);
     ASSERT_TRUE(out.speed_saturated);
+    // On the boundary: the chord clamp is exact up to the rounding of v~ = B^-1 w, whose entries
+    // (~1e6) amplify rounding of w (~1e-16 relative) to ~1e-9 V; 1e-6 V leaves margin.
     EXPECT_NEAR((out.v_AB_V - centre).norm(), 120.0, 1e-6) << centre.transpose();
     // And the speed gained is the most the disk allows along lambda1 for this flux control:
     // no input of the chord gives more (checked on a fine sweep of the boundary).
@@ -168,6 +170,8 @@ TEST_F(DsmcTest, ReachingLawsScaleTheErrors) {
   const auto out = law.step(in);
   ASSERT_EQ(out.status, DsmcStatus::ok);
   const auto next = model.predict(x, out.v_AB_V, 0.3);
+  // Deadbeat on the shifted targets, so the same rounding bound as the unlimited law (1e-9 of
+  // the speed, 1e-9 of the squared flux ~ 2e-10).
   EXPECT_NEAR(next.omega_mech_rad_s - 52.0, 0.9 * -2.0, 1e-9);
   EXPECT_NEAR(next.flux_r_AB_Wb.squaredNorm() - 0.21, 0.8 * -0.01, 1e-10);
 }

@@ -10,6 +10,10 @@
 namespace imd::control {
 namespace {
 
+// Tolerances in this file: a few operations on values of order 1e2 round to ~1e-14 absolute;
+// 1e-12 (values ~1e1) and 1e-9 (values ~3e2, through sqrt and division) leave wide margins
+// while any error in a formula is of the order of the values themselves.
+
 TEST(Clarke, RoundTripAndAmplitudeInvariance) {
   const Vec2<double> u(120.0, -35.0);
   const auto abc = inverse_clarke(u);

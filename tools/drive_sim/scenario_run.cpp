@@ -122,7 +122,9 @@ Summary run(const Scenario& s, const RunCallbacks& callbacks) {
   const double flux_decay = control::discretize_seed001(m, s.iol_period_s).flux_decay;
   Vec2 boundary_flux_s = Vec2::Zero();       // true stator flux (rotor frame) at the last boundary
   double pending_torque_cmd = std::nan("");  // the law's v1, due at the next boundary
-  SimRow held;                               // iol outputs held between boundaries
+  struct {
+    double torque_ref_Nm = 0.0, y2 = 0.0, y2_ref = 0.0;
+  } held;  // iol values of the last boundary, held until the next
   uint64_t measured = 0, saturated = 0;
   firmware::FaultCode last_fault = firmware::FaultCode::none;
   for (uint64_t k = 0; k < ticks; ++k) {
