@@ -1,0 +1,85 @@
+#pragma once
+/// A signal inside a classic CAN frame: Intel (little-endian) bit order, the DBC convention.
+/// physical = raw * scale + offset, with scale = scale_num / scale_den so that the DBC shows it
+/// exactly and the MCU packs it in single precision. No heap; usable in tick context.
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <span>
+
+namespace imd::firmware::protocol {
+
+/// A named raw value of an enumerated signal (a DBC VAL_ entry).
+struct ValueName {
+  int32_t raw;
+  const char* name;
+};
+
+struct Signal {
+  const char* name;
+  uint8_t start_bit;  ///< bit position of the least-significant bit
+  uint8_t length_bits;
+  bool is_signed;
+  int32_t scale_num = 1;
+  int32_t scale_den = 1;
+  float offset = 0.0f;
+  const char* unit = "";
+  const char* comment = "";
+  std::span<const ValueName> values = {};
+
+  constexpr double scale() const noexcept { return double(scale_num) / double(scale_den); }
+  constexpr int64_t raw_min() const noexcept {
+    return is_signed ? -(int64_t(1) << (length_bits - 1)) : 0;
+  }
+  constexpr int64_t raw_max() const noexcept {
+    return is_signed ? (int64_t(1) << (length_bits - 1)) - 1 : (int64_t(1) << length_bits) - 1;
+  }
+};
+
+using Payload = std::array<uint8_t, 8>;
+
+/// The raw bits of a signal (sign-extended for signed signals).
+constexpr int64_t get_raw(const Payload& data, const Signal& s) noexcept {
+  uint64_t bits = 0;
+  for (int i = 0; i < 8; ++i) bits |= uint64_t(data[i]) << (8 * i);
+  const uint64_t mask = s.length_bits >= 64 ? ~uint64_t(0) : (uint64_t(1) << s.length_bits) - 1;
+  uint64_t raw = (bits >> s.start_bit) & mask;
+  if (s.is_signed && s.length_bits < 64 && (raw >> (s.length_bits - 1)) != 0) raw |= ~mask;
+  return static_cast<int64_t>(raw);
+}
+
+/// Writes the raw bits of a signal; `raw` must be within [raw_min, raw_max].
+constexpr void set_raw(Payload& data, const Signal& s, int64_t raw) noexcept {
+  uint64_t bits = 0;
+  for (int i = 0; i < 8; ++i) bits |= uint64_t(data[i]) << (8 * i);
+  const uint64_t mask = s.length_bits >= 64 ? ~uint64_t(0) : (uint64_t(1) << s.length_bits) - 1;
+  bits &= ~(mask << s.start_bit);
+  bits |= (static_cast<uint64_t>(raw) & mask) << s.start_bit;
+  for (int i = 0; i < 8; ++i) data[i] = static_cast<uint8_t>(bits >> (8 * i));
+}
+
+/// The physical value of a signal, in single precision (what the MCU decodes with).
+inline float get_physical(const Payload& data, const Signal& s) noexcept {
+  return float(get_raw(data, s)) * float(s.scale_num) / float(s.scale_den) + s.offset;
+}
+
+/// The nearest raw value for a physical value, saturated to the signal's range. A NaN becomes
+/// raw_min: telemetry must never wrap around to a plausible value.
+inline int64_t to_raw(const Signal& s, float value) noexcept {
+  const float raw = std::round((value - s.offset) * float(s.scale_den) / float(s.scale_num));
+  if (!(raw >= float(s.raw_min()))) return s.raw_min();  // NaN and -Inf too
+  if (raw >= float(s.raw_max())) return s.raw_max();
+  return static_cast<int64_t>(raw);
+}
+
+inline void set_physical(Payload& data, const Signal& s, float value) noexcept {
+  set_raw(data, s, to_raw(s, value));
+}
+
+/// Whether a physical value is representable without saturation.
+inline bool in_range(const Signal& s, float value) noexcept {
+  const float raw = std::round((value - s.offset) * float(s.scale_den) / float(s.scale_num));
+  return raw >= float(s.raw_min()) && raw <= float(s.raw_max());
+}
+
+}  // namespace imd::firmware::protocol

@@ -1,0 +1,131 @@
+#include "firmware/protocol/commands.hpp"
+
+#include "firmware/protocol/e2e.hpp"
+
+namespace imd::firmware::protocol {
+namespace {
+
+constexpr const Signal& payload_signal(MessageId id) noexcept { return message(id).signals[2]; }
+
+}  // namespace
+
+MessageId message_for(CommandKind kind) noexcept {
+  switch (kind) {
+    case CommandKind::emergency_stop:
+      return MessageId::emergency_stop;
+    case CommandKind::disable:
+      return MessageId::disable;
+    case CommandKind::enable:
+      return MessageId::enable;
+    case CommandKind::clear_faults:
+      return MessageId::clear_faults;
+    case CommandKind::set_speed:
+      return MessageId::set_speed;
+    case CommandKind::set_flux:
+      return MessageId::set_flux;
+    case CommandKind::select_controller:
+      return MessageId::select_controller;
+    case CommandKind::set_telemetry_rate:
+      return MessageId::set_telemetry_rate;
+  }
+  return MessageId::disable;
+}
+
+uint32_t CommandDecoder::rejected_total() const noexcept {
+  uint32_t total = 0;
+  for (int i = 1; i < kCommandResultCount; ++i) total += rejections_[i];
+  return total;
+}
+
+Decoded CommandDecoder::reject(Decoded d, CommandResult reason) noexcept {
+  d.result = reason;
+  ++rejections_[int(reason)];
+  return d;
+}
+
+Decoded CommandDecoder::decode(const hal::CanFrame& frame) noexcept {
+  Decoded d;
+  if (frame.id > 0x7FF || node_of(frame.id) != node_id_) return d;
+  d.message_id = message_of(frame.id);
+  const Message* m = find_message(d.message_id);
+  if (m == nullptr || m->direction != Direction::host_to_drive) {
+    // The drive's own telemetry echoed on the bus is not a command; an unknown id is.
+    if (m != nullptr) return d;
+    d.for_this_node = true;
+    return reject(d, CommandResult::unknown_message);
+  }
+  d.for_this_node = true;
+  if (frame.length != m->length) return reject(d, CommandResult::wrong_length);
+  d.counter = e2e_counter(frame.data);
+  if (frame.data[0] != e2e_crc(frame.id, frame.data, frame.length)) {
+    return reject(d, CommandResult::bad_crc);
+  }
+  if (have_counter_) {
+    const uint8_t step = static_cast<uint8_t>((d.counter - last_counter_) & 0x0F);
+    if (step == 0) return reject(d, CommandResult::repeated_counter);
+    if (step > kMaxCounterStep) return reject(d, CommandResult::stale_counter);
+  }
+  Command& c = d.command;
+  switch (m->id) {
+    case MessageId::emergency_stop:
+      c.kind = CommandKind::emergency_stop;
+      break;
+    case MessageId::disable:
+      c.kind = CommandKind::disable;
+      break;
+    case MessageId::enable:
+      c.kind = CommandKind::enable;
+      break;
+    case MessageId::clear_faults:
+      c.kind = CommandKind::clear_faults;
+      break;
+    case MessageId::set_speed:
+      c.kind = CommandKind::set_speed;
+      c.value = get_physical(frame.data, payload_signal(MessageId::set_speed));
+      if (!(c.value >= -limits_.max_speed_rad_s && c.value <= limits_.max_speed_rad_s)) {
+        return reject(d, CommandResult::out_of_range);
+      }
+      break;
+    case MessageId::set_flux:
+      c.kind = CommandKind::set_flux;
+      c.value = get_physical(frame.data, payload_signal(MessageId::set_flux));
+      if (!(c.value > 0.0f && c.value <= limits_.max_flux2_Wb2)) {
+        return reject(d, CommandResult::out_of_range);
+      }
+      break;
+    case MessageId::select_controller:
+      c.kind = CommandKind::select_controller;
+      c.value = get_physical(frame.data, payload_signal(MessageId::select_controller));
+      if (!(c.value == 0.0f || c.value == 1.0f)) return reject(d, CommandResult::out_of_range);
+      break;
+    case MessageId::set_telemetry_rate:
+      c.kind = CommandKind::set_telemetry_rate;
+      c.value = get_physical(frame.data, payload_signal(MessageId::set_telemetry_rate));
+      if (!(c.value >= float(kFastTelemetryMinHz) && c.value <= float(kFastTelemetryMaxHz))) {
+        return reject(d, CommandResult::out_of_range);
+      }
+      break;
+    default:
+      return reject(d, CommandResult::unknown_message);
+  }
+  // Reserved bits must be zero, so that a future field is never misread as this one.
+  if ((frame.data[1] & 0xF0) != 0) return reject(d, CommandResult::out_of_range);
+  have_counter_ = true;
+  last_counter_ = d.counter;
+  d.result = CommandResult::accepted;
+  return d;
+}
+
+hal::CanFrame CommandEncoder::encode(const Command& command) noexcept {
+  const MessageId id = message_for(command.kind);
+  const Message& m = message(id);
+  hal::CanFrame frame;
+  frame.id = can_id(node_id_, id);
+  frame.length = m.length;
+  if (m.signals.size() > 2) set_physical(frame.data, m.signals[2], command.value);
+  e2e_protect(frame.id, frame.data, frame.length, counter_);
+  counter_ = static_cast<uint8_t>((counter_ + 1) & 0x0F);
+  return frame;
+}
+
+}  // namespace imd::firmware::protocol

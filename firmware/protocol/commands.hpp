@@ -1,0 +1,108 @@
+#pragma once
+/// Command frames: the typed commands, the decoder the drive runs on every received frame, and
+/// the encoder hosts use (drive_monitor, the simulator's scripted commands).
+///
+/// A frame is rejected, counted and reported (and changes nothing) when its length is not the
+/// message's, its CRC is wrong, its alive counter repeats the last accepted one or jumps by more
+/// than kMaxCounterStep (a stale or replayed frame), or a value is out of range. The first frame
+/// after start-up sets the counter reference. One counter covers all commands of a node, so a
+/// host that starts late learns where it stands from the heartbeat's command_counter.
+#include <array>
+#include <cstdint>
+
+#include "firmware/protocol/messages.hpp"
+#include "hal/can_bus.hpp"
+
+namespace imd::firmware::protocol {
+
+enum class CommandKind : uint8_t {
+  emergency_stop,
+  disable,
+  enable,
+  clear_faults,
+  set_speed,           ///< value: rad/s
+  set_flux,            ///< value: Wb^2
+  select_controller,   ///< value: 0 dsmc, 1 iol
+  set_telemetry_rate,  ///< value: Hz
+};
+
+struct Command {
+  CommandKind kind = CommandKind::disable;
+  float value = 0.0f;
+};
+
+/// Why a frame was rejected (the numbering is kCommandResultValues').
+enum class CommandResult : uint8_t {
+  accepted = 0,
+  wrong_length,
+  bad_crc,
+  repeated_counter,
+  stale_counter,
+  out_of_range,
+  not_allowed,  ///< valid, but not in the drive's present state (set by the application)
+  unknown_message,
+};
+inline constexpr int kCommandResultCount = 8;
+
+/// Largest accepted counter step: up to two lost frames in a row.
+inline constexpr uint8_t kMaxCounterStep = 3;
+
+/// The ranges the decoder enforces; the application sets them from its configuration.
+struct CommandLimits {
+  float max_speed_rad_s = 400.0f;  ///< |set_speed| <= this (the overspeed threshold)
+  float max_flux2_Wb2 = 4.0f;      ///< 0 < set_flux <= this
+};
+
+struct Decoded {
+  bool for_this_node = false;  ///< false: another node's frame or telemetry, ignored silently
+  CommandResult result = CommandResult::unknown_message;
+  uint8_t message_id = 0;
+  uint8_t counter = 0;
+  Command command;
+};
+
+/// The drive side. No heap, noexcept: runs in tick context.
+class CommandDecoder {
+ public:
+  CommandDecoder(uint8_t node_id, const CommandLimits& limits) noexcept
+      : node_id_(node_id), limits_(limits) {}
+
+  /// Checks a frame and, if it is a valid command for this node, advances the counter.
+  Decoded decode(const hal::CanFrame& frame) noexcept;
+
+  /// A command the application refuses in its present state: counted like a rejection.
+  void count_not_allowed() noexcept { ++rejections_[int(CommandResult::not_allowed)]; }
+
+  uint32_t rejected(CommandResult reason) const noexcept { return rejections_[int(reason)]; }
+  uint32_t rejected_total() const noexcept;
+  uint8_t last_counter() const noexcept { return last_counter_; }
+
+ private:
+  Decoded reject(Decoded d, CommandResult reason) noexcept;
+
+  uint8_t node_id_;
+  CommandLimits limits_;
+  bool have_counter_ = false;
+  uint8_t last_counter_ = 0;
+  std::array<uint32_t, kCommandResultCount> rejections_{};
+};
+
+/// The host side: typed commands to frames with the next alive counter and the CRC.
+class CommandEncoder {
+ public:
+  explicit CommandEncoder(uint8_t node_id, uint8_t first_counter = 0) noexcept
+      : node_id_(node_id), counter_(first_counter & 0x0F) {}
+  hal::CanFrame encode(const Command& command) noexcept;
+  /// The counter the next frame will carry.
+  uint8_t next_counter() const noexcept { return counter_; }
+  void set_next_counter(uint8_t counter) noexcept { counter_ = counter & 0x0F; }
+
+ private:
+  uint8_t node_id_;
+  uint8_t counter_;
+};
+
+/// The message that carries a command kind.
+MessageId message_for(CommandKind kind) noexcept;
+
+}  // namespace imd::firmware::protocol

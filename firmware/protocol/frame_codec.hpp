@@ -1,0 +1,40 @@
+#pragma once
+/// Packs and unpacks whole messages by their table entry, in signal order.
+#include <cstdint>
+#include <initializer_list>
+
+#include "firmware/protocol/messages.hpp"
+#include "hal/can_bus.hpp"
+
+namespace imd::firmware::protocol {
+
+/// A frame of message `id` for node `node_id` with `values` (physical, in signal order; missing
+/// values are 0, extra ones ignored). Saturates values outside a signal's range. Tick context.
+inline hal::CanFrame encode_frame(uint8_t node_id, MessageId id,
+                                  std::initializer_list<float> values) noexcept {
+  const Message& m = message(id);
+  hal::CanFrame frame;
+  frame.id = can_id(node_id, id);
+  frame.length = m.length;
+  std::size_t i = 0;
+  for (const float value : values) {
+    if (i >= m.signals.size()) break;
+    set_physical(frame.data, m.signals[i++], value);
+  }
+  return frame;
+}
+
+/// The physical value of signal `index` of a frame, in double precision (host tools).
+inline double decode_signal(const hal::CanFrame& frame, const Signal& s) noexcept {
+  return double(get_raw(frame.data, s)) * s.scale() + double(s.offset);
+}
+
+/// The name of an enumerated raw value, or nullptr.
+constexpr const char* value_name(const Signal& s, int64_t raw) noexcept {
+  for (const ValueName& v : s.values) {
+    if (v.raw == raw) return v.name;
+  }
+  return nullptr;
+}
+
+}  // namespace imd::firmware::protocol

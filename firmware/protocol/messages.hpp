@@ -1,0 +1,239 @@
+#pragma once
+/// The drive's CAN protocol: every message with its identifier, length, direction, rate and
+/// signals. This table is the single source of truth: the firmware packs and unpacks with it,
+/// drive_monitor decodes with it, and dbc_gen writes docs/can/drive.dbc from it.
+///
+/// Classic CAN, 11-bit identifiers: can_id = node_id * 32 + message id (node_id 0..63), as
+/// ODrive does. Lower identifiers win arbitration, so the emergency stop is message 1.
+/// Commands (host -> drive) carry a CRC-8 in byte 0 and a 4-bit alive counter in byte 1
+/// (firmware/protocol/e2e.hpp). docs/can/protocol.md explains the behaviour behind each message.
+#include <cstdint>
+#include <span>
+
+#include "firmware/protocol/can_signal.hpp"
+
+namespace imd::firmware::protocol {
+
+inline constexpr uint32_t kNominalBitrate_bit_s = 1'000'000;
+inline constexpr int kMaxNodeId = 63;
+
+enum class MessageId : uint8_t {
+  emergency_stop = 0x01,
+  heartbeat = 0x02,
+  fault_report = 0x03,
+  disable = 0x04,
+  enable = 0x05,
+  clear_faults = 0x06,
+  set_speed = 0x07,
+  set_flux = 0x08,
+  select_controller = 0x09,
+  set_telemetry_rate = 0x0A,
+  command_ack = 0x0B,
+  state_change = 0x0C,
+  telemetry_speed_flux = 0x10,
+  telemetry_current = 0x11,
+  telemetry_voltage = 0x12,
+  timing = 0x13,
+};
+
+enum class Direction : uint8_t {
+  drive_to_host,  ///< telemetry and reports
+  host_to_drive,  ///< commands (E2E protected)
+};
+
+/// How often a message is sent.
+enum class Timing : uint8_t {
+  cyclic,        ///< every period_ms
+  configurable,  ///< fast telemetry: period_ms is the default, set_telemetry_rate changes it
+  on_event,      ///< on a state change, a fault, or a command
+};
+
+struct Message {
+  MessageId id;
+  const char* name;
+  uint8_t length;  ///< DLC, exact: a command of another length is rejected
+  Direction direction;
+  Timing timing;
+  uint16_t period_ms;  ///< cyclic and configurable messages
+  const char* comment;
+  std::span<const Signal> signals;
+
+  constexpr bool e2e() const noexcept { return direction == Direction::host_to_drive; }
+};
+
+constexpr uint16_t can_id(uint8_t node_id, MessageId id) noexcept {
+  return static_cast<uint16_t>(node_id * 32 + static_cast<uint8_t>(id));
+}
+constexpr uint8_t node_of(uint16_t can_id) noexcept { return static_cast<uint8_t>(can_id >> 5); }
+constexpr uint8_t message_of(uint16_t can_id) noexcept {
+  return static_cast<uint8_t>(can_id & 0x1F);
+}
+
+// --- value tables (kept in step with the firmware's enums by static_asserts where they live)
+
+inline constexpr ValueName kStateValues[] = {
+    {0, "calibrating"}, {1, "idle"}, {2, "magnetizing"},
+    {3, "running"},     {4, "stopping"}, {5, "fault"},
+};
+inline constexpr ValueName kFaultValues[] = {
+    {0, "none"},
+    {1, "adc_offset"},
+    {2, "overcurrent"},
+    {3, "magnetizing_timeout"},
+    {4, "non_finite"},
+    {5, "singular_control"},
+    {6, "bus_undervoltage"},
+    {7, "bus_overvoltage"},
+    {8, "overrun"},
+    {9, "overspeed"},
+    {10, "encoder"},
+    {11, "adc_stuck"},
+    {12, "phase_loss"},
+    {13, "command_timeout"},
+    {14, "emergency_stop"},
+};
+inline constexpr ValueName kControllerValues[] = {{0, "dsmc"}, {1, "iol"}};
+inline constexpr ValueName kCommandResultValues[] = {
+    {0, "accepted"},     {1, "wrong_length"}, {2, "bad_crc"},     {3, "repeated_counter"},
+    {4, "stale_counter"}, {5, "out_of_range"}, {6, "not_allowed"}, {7, "unknown_message"},
+};
+inline constexpr ValueName kTransitionReasonValues[] = {
+    {0, "calibrated"}, {1, "enable"},  {2, "magnetized"}, {3, "disable"},
+    {4, "stopped"},    {5, "fault"},   {6, "clear_faults"},
+};
+
+// --- the E2E header every command starts with
+inline constexpr Signal kE2eCrc{"crc", 0, 8, false, 1, 1, 0.0f, "", "CRC-8 SAE J1850 over id and bytes 1.."};
+inline constexpr Signal kE2eCounter{"counter", 8, 4, false, 1, 1, 0.0f, "",
+                                    "alive counter, +1 (mod 16) per command frame"};
+
+// --- signals, one array per message. Signal order is the telemetry's field order.
+inline constexpr Signal kHeartbeatSignals[] = {
+    {"state", 0, 8, false, 1, 1, 0.0f, "", "drive state", kStateValues},
+    {"fault_bits", 8, 16, false, 1, 1, 0.0f, "", "latched faults, bit n = fault code n"},
+    {"first_fault", 24, 8, false, 1, 1, 0.0f, "", "first latched fault", kFaultValues},
+    {"counter", 32, 8, false, 1, 1, 0.0f, "", "heartbeat count, wraps"},
+    {"command_counter", 40, 4, false, 1, 1, 0.0f, "", "alive counter of the last accepted command"},
+    {"controller", 44, 2, false, 1, 1, 0.0f, "", "selected controller", kControllerValues},
+    {"can_bus_off", 46, 1, false, 1, 1, 0.0f, "", "the CAN controller was bus-off"},
+    {"rejected_commands", 48, 8, false, 1, 1, 0.0f, "", "rejected command frames, wraps"},
+    {"transitions", 56, 8, false, 1, 1, 0.0f, "", "state transitions, wraps"},
+};
+inline constexpr Signal kFaultReportSignals[] = {
+    {"first_fault", 0, 8, false, 1, 1, 0.0f, "", "first latched fault", kFaultValues},
+    {"fault_bits", 8, 16, false, 1, 1, 0.0f, "", "latched faults, bit n = fault code n"},
+    {"first_fault_time_ms", 24, 32, false, 1, 1, 0.0f, "ms", "drive time of the first fault"},
+    {"detail", 56, 8, false, 1, 1, 0.0f, "", "phase (0..2) for overcurrent and phase loss"},
+};
+inline constexpr Signal kEmptyCommandSignals[] = {kE2eCrc, kE2eCounter};
+inline constexpr Signal kSetSpeedSignals[] = {
+    kE2eCrc, kE2eCounter,
+    {"speed_ref_rad_s", 16, 32, true, 1, 1000, 0.0f, "rad/s", "mechanical speed reference"}};
+inline constexpr Signal kSetFluxSignals[] = {
+    kE2eCrc, kE2eCounter,
+    {"flux2_ref_Wb2", 16, 32, false, 1, 1000000, 0.0f, "Wb^2",
+     "squared flux reference: rotor flux (dsmc) or stator flux (iol)"}};
+inline constexpr Signal kSelectControllerSignals[] = {
+    kE2eCrc, kE2eCounter,
+    {"controller", 16, 8, false, 1, 1, 0.0f, "", "controller, only while idle",
+     kControllerValues}};
+inline constexpr Signal kSetTelemetryRateSignals[] = {
+    kE2eCrc, kE2eCounter,
+    {"rate_Hz", 16, 16, false, 1, 1, 0.0f, "Hz", "fast telemetry rate, 10..1000"}};
+inline constexpr Signal kCommandAckSignals[] = {
+    {"message", 0, 8, false, 1, 1, 0.0f, "", "message id of the command"},
+    {"counter", 8, 4, false, 1, 1, 0.0f, "", "its alive counter"},
+    {"result", 12, 4, false, 1, 1, 0.0f, "", "accepted or why it was rejected",
+     kCommandResultValues},
+    {"rejected_total", 16, 16, false, 1, 1, 0.0f, "", "rejected command frames since boot"},
+};
+inline constexpr Signal kStateChangeSignals[] = {
+    {"from", 0, 8, false, 1, 1, 0.0f, "", "previous state", kStateValues},
+    {"to", 8, 8, false, 1, 1, 0.0f, "", "new state", kStateValues},
+    {"reason", 16, 8, false, 1, 1, 0.0f, "", "why", kTransitionReasonValues},
+    {"transitions", 24, 8, false, 1, 1, 0.0f, "", "state transitions, wraps"},
+    {"time_ms", 32, 32, false, 1, 1, 0.0f, "ms", "drive time of the transition"},
+};
+inline constexpr Signal kSpeedFluxSignals[] = {
+    {"speed_rad_s", 0, 16, true, 1, 100, 0.0f, "rad/s", "estimated mechanical speed"},
+    {"speed_ref_rad_s", 16, 16, true, 1, 100, 0.0f, "rad/s", "speed reference (after the ramp)"},
+    {"flux2_Wb2", 32, 16, false, 1, 10000, 0.0f, "Wb^2", "estimated squared flux"},
+    {"flux2_ref_Wb2", 48, 16, false, 1, 10000, 0.0f, "Wb^2", "squared flux reference"},
+};
+inline constexpr Signal kCurrentSignals[] = {
+    {"i_A_A", 0, 16, true, 1, 100, 0.0f, "A", "stator current, rotor frame, A axis"},
+    {"i_B_A", 16, 16, true, 1, 100, 0.0f, "A", "stator current, rotor frame, B axis"},
+    {"load_Nm", 32, 16, true, 1, 100, 0.0f, "N.m", "estimated load torque"},
+    {"v_bus_V", 48, 16, false, 1, 10, 0.0f, "V", "measured DC bus"},
+};
+inline constexpr Signal kVoltageSignals[] = {
+    {"u_alpha_V", 0, 16, true, 1, 10, 0.0f, "V", "stator voltage command, alpha"},
+    {"u_beta_V", 16, 16, true, 1, 10, 0.0f, "V", "stator voltage command, beta"},
+    {"sample", 32, 8, false, 1, 1, 0.0f, "", "telemetry sample count, wraps"},
+};
+inline constexpr Signal kTimingSignals[] = {
+    {"exec_mean_us", 0, 16, false, 1, 100, 0.0f, "us", "mean tick execution time"},
+    {"exec_max_us", 16, 16, false, 1, 100, 0.0f, "us", "longest tick"},
+    {"overruns", 32, 16, false, 1, 1, 0.0f, "", "ticks over budget, saturates"},
+    {"budget_us", 48, 16, false, 1, 100, 0.0f, "us", "tick budget (0: not checked)"},
+};
+
+inline constexpr Message kMessages[] = {
+    {MessageId::emergency_stop, "emergency_stop", 2, Direction::host_to_drive, Timing::on_event,
+     0, "PWM off at once, latched as a fault", kEmptyCommandSignals},
+    {MessageId::heartbeat, "heartbeat", 8, Direction::drive_to_host, Timing::cyclic, 100,
+     "state, faults and counters at 10 Hz", kHeartbeatSignals},
+    {MessageId::fault_report, "fault_report", 8, Direction::drive_to_host, Timing::on_event, 0,
+     "sent when a fault latches", kFaultReportSignals},
+    {MessageId::disable, "disable", 2, Direction::host_to_drive, Timing::on_event, 0,
+     "ramp to a stop, then PWM off", kEmptyCommandSignals},
+    {MessageId::enable, "enable", 2, Direction::host_to_drive, Timing::on_event, 0,
+     "idle -> magnetizing -> running", kEmptyCommandSignals},
+    {MessageId::clear_faults, "clear_faults", 2, Direction::host_to_drive, Timing::on_event, 0,
+     "fault -> idle", kEmptyCommandSignals},
+    {MessageId::set_speed, "set_speed", 6, Direction::host_to_drive, Timing::on_event, 0,
+     "speed reference, within +-overspeed", kSetSpeedSignals},
+    {MessageId::set_flux, "set_flux", 6, Direction::host_to_drive, Timing::on_event, 0,
+     "squared flux reference, (0, max]", kSetFluxSignals},
+    {MessageId::select_controller, "select_controller", 3, Direction::host_to_drive,
+     Timing::on_event, 0, "dsmc or iol, only while idle", kSelectControllerSignals},
+    {MessageId::set_telemetry_rate, "set_telemetry_rate", 4, Direction::host_to_drive,
+     Timing::on_event, 0, "fast telemetry rate", kSetTelemetryRateSignals},
+    {MessageId::command_ack, "command_ack", 4, Direction::drive_to_host, Timing::on_event, 0,
+     "the result of every command frame addressed to this node", kCommandAckSignals},
+    {MessageId::state_change, "state_change", 8, Direction::drive_to_host, Timing::on_event, 0,
+     "sent on every state transition", kStateChangeSignals},
+    {MessageId::telemetry_speed_flux, "telemetry_speed_flux", 8, Direction::drive_to_host,
+     Timing::configurable, 10, "fast telemetry 1/3", kSpeedFluxSignals},
+    {MessageId::telemetry_current, "telemetry_current", 8, Direction::drive_to_host,
+     Timing::configurable, 10, "fast telemetry 2/3", kCurrentSignals},
+    {MessageId::telemetry_voltage, "telemetry_voltage", 5, Direction::drive_to_host,
+     Timing::configurable, 10, "fast telemetry 3/3, sent last", kVoltageSignals},
+    {MessageId::timing, "timing", 8, Direction::drive_to_host, Timing::cyclic, 100,
+     "tick execution time at 10 Hz", kTimingSignals},
+};
+
+/// The definition of a message id, or nullptr.
+constexpr const Message* find_message(uint8_t message_id) noexcept {
+  for (const Message& m : kMessages) {
+    if (static_cast<uint8_t>(m.id) == message_id) return &m;
+  }
+  return nullptr;
+}
+constexpr const Message& message(MessageId id) noexcept { return *find_message(uint8_t(id)); }
+
+/// The index of a signal in its message, or -1.
+constexpr int find_signal(const Message& m, const char* name) noexcept {
+  for (std::size_t i = 0; i < m.signals.size(); ++i) {
+    const char* a = m.signals[i].name;
+    const char* b = name;
+    while (*a != '\0' && *a == *b) ++a, ++b;
+    if (*a == *b) return static_cast<int>(i);
+  }
+  return -1;
+}
+
+inline constexpr int kFastTelemetryMinHz = 10;
+inline constexpr int kFastTelemetryMaxHz = 1000;
+
+}  // namespace imd::firmware::protocol

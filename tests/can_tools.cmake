@@ -1,0 +1,1 @@
+# CAN tool tests (filled in below)

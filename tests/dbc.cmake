@@ -1,0 +1,1 @@
+# DBC tests (filled in below)

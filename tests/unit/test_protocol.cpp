@@ -1,0 +1,176 @@
+// The CAN protocol table, signal packing, the E2E CRC and the command decoder's rejections.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <set>
+
+#include "firmware/protocol/commands.hpp"
+#include "firmware/protocol/e2e.hpp"
+#include "firmware/protocol/frame_codec.hpp"
+
+namespace imd::firmware::protocol {
+namespace {
+
+TEST(Crc8, MatchesTheSaeJ1850CheckValue) {
+  // CRC-8/SAE-J1850 (poly 0x1D, init 0xFF, xorout 0xFF) of "123456789" is 0x4B.
+  const uint8_t text[] = {'1', '2', '3', '4', '5', '6', '7', '8', '9'};
+  EXPECT_EQ(crc8_sae_j1850(text, 9) ^ 0xFF, 0x4B);
+}
+
+TEST(MessageTable, IdsAreUniqueAndSignalsFitTheirFrame) {
+  std::set<int> ids;
+  for (const Message& m : kMessages) {
+    EXPECT_TRUE(ids.insert(int(m.id)).second) << m.name;
+    EXPECT_LT(int(m.id), 32) << m.name;
+    EXPECT_LE(m.length, 8) << m.name;
+    uint64_t used = 0;
+    for (const Signal& s : m.signals) {
+      EXPECT_LE(s.start_bit + s.length_bits, 8 * m.length) << m.name << "." << s.name;
+      const uint64_t bits = ((uint64_t(1) << s.length_bits) - 1) << s.start_bit;
+      EXPECT_EQ(used & bits, 0u) << m.name << "." << s.name << " overlaps";
+      used |= bits;
+    }
+    if (m.e2e()) {
+      ASSERT_GE(m.signals.size(), 2u);
+      EXPECT_STREQ(m.signals[0].name, "crc");
+      EXPECT_STREQ(m.signals[1].name, "counter");
+    }
+  }
+}
+
+TEST(SignalPacking, RoundTripsSignedValuesAndSaturates) {
+  const Signal& speed = kSpeedFluxSignals[0];  // int16, 0.01 rad/s
+  Payload data{};
+  set_physical(data, speed, -123.45f);
+  EXPECT_EQ(get_raw(data, speed), -12345);
+  EXPECT_NEAR(get_physical(data, speed), -123.45f, 0.005f);
+  set_physical(data, speed, 1e6f);
+  EXPECT_EQ(get_raw(data, speed), 32767);
+  set_physical(data, speed, std::nanf(""));
+  EXPECT_EQ(get_raw(data, speed), -32768);  // NaN never looks like a plausible value
+  // Neighbours are untouched.
+  set_physical(data, kSpeedFluxSignals[1], 7.0f);
+  EXPECT_EQ(get_raw(data, speed), -32768);
+  EXPECT_EQ(get_raw(data, kSpeedFluxSignals[1]), 700);
+}
+
+TEST(SignalPacking, NodeAndMessageFormTheIdentifier) {
+  EXPECT_EQ(can_id(1, MessageId::heartbeat), 0x22);
+  EXPECT_EQ(can_id(63, MessageId::timing), 63 * 32 + 0x13);
+  EXPECT_EQ(node_of(can_id(5, MessageId::set_speed)), 5);
+  EXPECT_EQ(message_of(can_id(5, MessageId::set_speed)), 0x07);
+}
+
+class Decoder : public ::testing::Test {
+ protected:
+  CommandDecoder decoder{1, CommandLimits{100.0f, 1.0f}};
+  CommandEncoder encoder{1};
+};
+
+TEST_F(Decoder, AcceptsAValidSequence) {
+  const Decoded a = decoder.decode(encoder.encode({CommandKind::set_speed, 50.0f}));
+  ASSERT_EQ(a.result, CommandResult::accepted);
+  EXPECT_EQ(a.command.kind, CommandKind::set_speed);
+  EXPECT_NEAR(a.command.value, 50.0f, 1e-3f);
+  const Decoded b = decoder.decode(encoder.encode({CommandKind::enable}));
+  EXPECT_EQ(b.result, CommandResult::accepted);
+  EXPECT_EQ(b.counter, 1);
+  EXPECT_EQ(decoder.last_counter(), 1);
+  EXPECT_EQ(decoder.rejected_total(), 0u);
+}
+
+TEST_F(Decoder, CounterWrapsAroundSixteen) {
+  for (int i = 0; i < 40; ++i) {
+    EXPECT_EQ(decoder.decode(encoder.encode({CommandKind::enable})).result,
+              CommandResult::accepted)
+        << i;
+  }
+}
+
+TEST_F(Decoder, RejectsABadCrcAndChangesNothing) {
+  ASSERT_EQ(decoder.decode(encoder.encode({CommandKind::enable})).result,
+            CommandResult::accepted);
+  hal::CanFrame f = encoder.encode({CommandKind::set_speed, 10.0f});
+  f.data[3] ^= 0x01;  // one payload bit flipped on the wire
+  EXPECT_EQ(decoder.decode(f).result, CommandResult::bad_crc);
+  EXPECT_EQ(decoder.rejected(CommandResult::bad_crc), 1u);
+  EXPECT_EQ(decoder.last_counter(), 0);  // the counter did not advance
+}
+
+TEST_F(Decoder, RejectsAFrameMeantForAnotherMessage) {
+  // The same payload moved to another identifier fails the CRC: the id is part of it.
+  hal::CanFrame f = encoder.encode({CommandKind::disable});
+  f.id = can_id(1, MessageId::enable);
+  EXPECT_EQ(decoder.decode(f).result, CommandResult::bad_crc);
+}
+
+TEST_F(Decoder, RejectsARepeatedCounter) {
+  const hal::CanFrame f = encoder.encode({CommandKind::enable});
+  EXPECT_EQ(decoder.decode(f).result, CommandResult::accepted);
+  EXPECT_EQ(decoder.decode(f).result, CommandResult::repeated_counter);
+  EXPECT_EQ(decoder.rejected(CommandResult::repeated_counter), 1u);
+}
+
+TEST_F(Decoder, RejectsAStaleCounter) {
+  EXPECT_EQ(decoder.decode(encoder.encode({CommandKind::enable})).result,
+            CommandResult::accepted);
+  encoder.set_next_counter(0 + kMaxCounterStep + 1);  // more frames lost than allowed
+  EXPECT_EQ(decoder.decode(encoder.encode({CommandKind::enable})).result,
+            CommandResult::stale_counter);
+  encoder.set_next_counter(15);  // one behind: a replayed frame
+  EXPECT_EQ(decoder.decode(encoder.encode({CommandKind::enable})).result,
+            CommandResult::stale_counter);
+  encoder.set_next_counter(kMaxCounterStep);  // the largest step allowed
+  EXPECT_EQ(decoder.decode(encoder.encode({CommandKind::enable})).result,
+            CommandResult::accepted);
+}
+
+TEST_F(Decoder, RejectsAWrongLength) {
+  hal::CanFrame f = encoder.encode({CommandKind::set_speed, 1.0f});
+  f.length = 5;
+  EXPECT_EQ(decoder.decode(f).result, CommandResult::wrong_length);
+  f.length = 8;
+  EXPECT_EQ(decoder.decode(f).result, CommandResult::wrong_length);
+}
+
+TEST_F(Decoder, RejectsOutOfRangeValues) {
+  EXPECT_EQ(decoder.decode(encoder.encode({CommandKind::set_speed, 100.5f})).result,
+            CommandResult::out_of_range);
+  EXPECT_EQ(decoder.decode(encoder.encode({CommandKind::set_flux, 0.0f})).result,
+            CommandResult::out_of_range);
+  EXPECT_EQ(decoder.decode(encoder.encode({CommandKind::set_flux, 1.5f})).result,
+            CommandResult::out_of_range);
+  EXPECT_EQ(decoder.decode(encoder.encode({CommandKind::select_controller, 2.0f})).result,
+            CommandResult::out_of_range);
+  EXPECT_EQ(decoder.decode(encoder.encode({CommandKind::set_telemetry_rate, 5.0f})).result,
+            CommandResult::out_of_range);
+  EXPECT_EQ(decoder.decode(encoder.encode({CommandKind::set_telemetry_rate, 1001.0f})).result,
+            CommandResult::out_of_range);
+  EXPECT_EQ(decoder.rejected(CommandResult::out_of_range), 6u);
+  // The counter never advanced, so the next valid frame may step from anywhere.
+  EXPECT_EQ(decoder.decode(encoder.encode({CommandKind::set_flux, 0.5f})).result,
+            CommandResult::accepted);
+}
+
+TEST_F(Decoder, RejectsReservedBitsAndUnknownMessages) {
+  hal::CanFrame f = encoder.encode({CommandKind::enable});
+  f.data[1] |= 0x40;
+  f.data[0] = e2e_crc(f.id, f.data, f.length);  // a well-formed frame from a newer host
+  EXPECT_EQ(decoder.decode(f).result, CommandResult::out_of_range);
+  hal::CanFrame unknown;
+  unknown.id = can_id(1, MessageId(0x1F));
+  unknown.length = 2;
+  EXPECT_EQ(decoder.decode(unknown).result, CommandResult::unknown_message);
+}
+
+TEST_F(Decoder, IgnoresOtherNodesAndTelemetry) {
+  CommandEncoder other(2);
+  const Decoded d = decoder.decode(other.encode({CommandKind::enable}));
+  EXPECT_FALSE(d.for_this_node);
+  const Decoded t = decoder.decode(encode_frame(1, MessageId::heartbeat, {3.0f}));
+  EXPECT_FALSE(t.for_this_node);
+  EXPECT_EQ(decoder.rejected_total(), 0u);
+}
+
+}  // namespace
+}  // namespace imd::firmware::protocol
