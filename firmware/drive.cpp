@@ -16,6 +16,11 @@ bool finite(const control::Vec2<T>& v) noexcept {
   return std::isfinite(v.x()) && std::isfinite(v.y());
 }
 
+/// A duration in whole ticks, rounded up (construction only).
+uint64_t ticks(double duration_s, double period_s) noexcept {
+  return duration_s > 0 ? static_cast<uint64_t>(std::ceil(duration_s / period_s - 1e-9)) : 0;
+}
+
 }  // namespace
 
 template <typename T>
@@ -24,7 +29,8 @@ Drive<T>::Drive(const control::MotorParameters& motor, const DriveConfig& config
                 const StateOracle* oracle)
     : config_(config),
       hw_(peripherals),
-      references_(references),
+      commanded_(config.flux2_ref_Wb2, config.stator_flux2_ref_Wb2),
+      references_(config.commands_over_can ? commanded_ : references),
       oracle_(oracle),
       coefficients_(control::discretize_seed000(motor, config.sample_period_s)),
       model_(coefficients_),
@@ -37,7 +43,21 @@ Drive<T>::Drive(const control::MotorParameters& motor, const DriveConfig& config
                                                     config.load_estimator_pole)),
       current_loop_(coefficients_),
       speed_ramp_(config.max_accel_rad_s2, config.sample_period_s),
-      iol_stage_(motor, config) {
+      iol_stage_(motor, config),
+      controller_(config.controller),
+      decoder_(config.node_id,
+               {float(config.protection.overspeed_rad_s), float(config.max_flux2_Wb2)}),
+      telemetry_(config.node_id, peripherals.timer.period_ns(), config.telemetry_rate_Hz),
+      encoder_check_({double(peripherals.encoder.counts_per_rev()), config.sample_period_s,
+                      motor.J_kgm2, motor.friction_Nms, config.protection.encoder_missing_counts,
+                      config.protection.encoder_window_s, config.protection.overspeed_rad_s}),
+      adc_stuck_check_(config.protection.adc_stuck_ticks, config.sample_period_s,
+                       control::derive_seed000(motor).sigma_H,
+                       double(peripherals.adc.scale().phase_A_per_code)),
+      phase_loss_check_(config.protection.phase_loss_ratio,
+                        config.protection.phase_loss_min_current_A,
+                        static_cast<uint32_t>(ticks(config.protection.phase_loss_max_window_s,
+                                                    config.sample_period_s))) {
   const control::Seed000Constants k = control::derive_seed000(motor);
   sigma_H_ = T(k.sigma_H);
   beta_per_H_ = T(k.beta_per_H);
@@ -48,19 +68,43 @@ Drive<T>::Drive(const control::MotorParameters& motor, const DriveConfig& config
   a21_ = T(coefficients_.a21);
   a22_ = T(coefficients_.a22);
   b2_ = T(coefficients_.b2);
+  torque_per_AWb_ = T(control::kClarkeTorqueFactor * motor.pole_pairs * motor.Lm_H / motor.Lr_H);
+  magnetizing_timeout_ticks_ = ticks(config.magnetizing_timeout_s, config.sample_period_s);
+  command_timeout_ticks_ = ticks(config.protection.command_timeout_s, config.sample_period_s);
+  stop_timeout_ticks_ = ticks(config.stop_timeout_s, config.sample_period_s);
+  status_.controller = controller_ == ControllerKind::iol ? 1 : 0;
   hw_.pwm.disable();
   if (config_.adc_calibration_ticks <= 0) {
     const auto scale = hw_.adc.scale();
     for (T& offset : offset_code_) offset = T(scale.phase_mid_code);
-    state_ = DriveState::magnetizing;
+    machine_.go(DriveState::idle, TransitionReason::calibrated, 0);
+    if (config_.auto_enable) enable(0);
   }
+  status_.state = machine_.state();
 }
 
 template <typename T>
-void Drive<T>::trip(FaultCode code) noexcept {
+void Drive<T>::trip(FaultCode code, uint64_t k, uint8_t detail) noexcept {
   hw_.pwm.disable();
-  if (state_ != DriveState::fault) fault_ = code;  // the first fault is kept
-  state_ = DriveState::fault;
+  status_.fault_bits = static_cast<uint16_t>(status_.fault_bits | (1u << unsigned(code)));
+  if (machine_.state() == DriveState::fault) return;  // the first fault is kept
+  status_.first_fault = code;
+  status_.first_fault_tick = k;
+  status_.fault_detail = detail;
+  machine_.go(DriveState::fault, TransitionReason::fault, k);
+  status_.state = DriveState::fault;
+  if (hw_.can != nullptr) telemetry_.report_fault(*hw_.can, status_);
+}
+
+template <typename T>
+bool Drive<T>::modulating() const noexcept {
+  const DriveState s = machine_.state();
+  return s == DriveState::magnetizing || s == DriveState::running || s == DriveState::stopping;
+}
+
+template <typename T>
+T Drive<T>::electromagnetic_torque_Nm(const control::RotorFrameState<T>& x) const noexcept {
+  return torque_per_AWb_ * control::dot_J<T>(x.i_s_AB_A, x.flux_r_AB_Wb);
 }
 
 template <typename T>
@@ -72,7 +116,7 @@ bool Drive<T>::calibrate_adc(const hal::AdcSample& sample) noexcept {
     offset_code_[phase] = T(calibration_sum_[phase]) / T(calibration_count_);
     const T offset_A = (offset_code_[phase] - T(scale.phase_mid_code)) * T(scale.phase_A_per_code);
     if (std::abs(offset_A) > T(config_.adc_offset_limit_A)) {
-      trip(FaultCode::adc_offset);
+      trip(FaultCode::adc_offset, hw_.timer.tick_count(), uint8_t(phase));
       return false;
     }
   }
@@ -85,7 +129,8 @@ typename Drive<T>::Estimate Drive<T>::estimate(const hal::AdcSample& sample) noe
   const uint32_t count = hw_.encoder.count();
   const int64_t cpr = hw_.encoder.counts_per_rev();
   if (!encoder_started_) last_encoder_count_ = count;
-  encoder_position_ += static_cast<int32_t>(count - last_encoder_count_);
+  encoder_delta_counts_ = static_cast<int32_t>(count - last_encoder_count_);
+  encoder_position_ += encoder_delta_counts_;
   last_encoder_count_ = count;
   encoder_position_ = ((encoder_position_ % cpr) + cpr) % cpr;
   const T theta_measured_rad = T(2 * std::numbers::pi) * T(encoder_position_) / T(cpr);
@@ -111,6 +156,7 @@ typename Drive<T>::Estimate Drive<T>::estimate(const hal::AdcSample& sample) noe
     adc_saturated_ = adc_saturated_ || sample.phase_code[phase] == 0 ||
                      sample.phase_code[phase] >= scale.max_code;
   }
+  for (int phase = 0; phase < 3; ++phase) phase_current_A_[phase] = i_abc[phase];
   const Vec2 i_alphabeta = control::clarke(i_abc);
   record_.i_alpha_A = double(i_alphabeta.x());
   record_.i_beta_A = double(i_alphabeta.y());
@@ -126,6 +172,7 @@ typename Drive<T>::Estimate Drive<T>::estimate(const hal::AdcSample& sample) noe
                  .apply(e.x.i_s_AB_A)));
     peak_phase_current_A_ =
         std::max({std::abs(true_abc[0]), std::abs(true_abc[1]), std::abs(true_abc[2])});
+    for (int phase = 0; phase < 3; ++phase) phase_current_A_[phase] = true_abc[phase];
     e.x.omega_mech_rad_s = T(truth.omega_mech_rad_s);
     e.x.theta_mech_rad = T(truth.theta_mech_rad);
     if (config_.section_iv_load_estimator) {
@@ -165,7 +212,7 @@ control::Vec2<T> Drive<T>::magnetizing_current(const control::RotorFrameState<T>
   // Steady state at zero slip: Phi_r = Lm I and phi_s = Ls I.
   T current_A = T(config_.magnetizing_current_A);
   if (!(current_A > T(0))) {
-    current_A = config_.controller == ControllerKind::iol
+    current_A = controller_ == ControllerKind::iol
                     ? std::sqrt(std::max(T(ref.stator_flux2_Wb2), T(0))) / Ls_H_
                     : std::sqrt(std::max(T(ref.flux2_Wb2), T(0))) / Lm_H_;
   }
@@ -177,13 +224,193 @@ control::Vec2<T> Drive<T>::magnetizing_current(const control::RotorFrameState<T>
 
 template <typename T>
 T Drive<T>::magnetized_flux2(const control::RotorFrameState<T>& x) const noexcept {
-  if (config_.controller != ControllerKind::iol) return x.flux_r_AB_Wb.squaredNorm();
+  if (controller_ != ControllerKind::iol) return x.flux_r_AB_Wb.squaredNorm();
   return (sigma_H_ * x.i_s_AB_A + Lm_over_Lr_ * x.flux_r_AB_Wb).squaredNorm();
 }
 
 template <typename T>
 T Drive<T>::magnetized_flux2_ref(const Reference& ref) const noexcept {
-  return T(config_.controller == ControllerKind::iol ? ref.stator_flux2_Wb2 : ref.flux2_Wb2);
+  return T(controller_ == ControllerKind::iol ? ref.stator_flux2_Wb2 : ref.flux2_Wb2);
+}
+
+template <typename T>
+void Drive<T>::protect(uint64_t k, const Estimate& e, const hal::AdcSample& sample,
+                       T v_bus_V) noexcept {
+  const ProtectionConfig& p = config_.protection;
+  // In every state: what would harm the inverter or the motor even with the PWM off.
+  if (peak_phase_current_A_ > T(p.overcurrent_A) || adc_saturated_) {
+    int phase = 0;
+    for (int i = 1; i < 3; ++i) {
+      if (std::abs(phase_current_A_[i]) > std::abs(phase_current_A_[phase])) phase = i;
+    }
+    trip(FaultCode::overcurrent, k, uint8_t(phase));
+  }
+  if (v_bus_V > T(p.bus_max_V)) trip(FaultCode::bus_overvoltage, k);
+  if (std::abs(e.x.omega_mech_rad_s) > T(p.overspeed_rad_s)) trip(FaultCode::overspeed, k);
+  if (!finite(e.x.flux_r_AB_Wb) || !finite(e.x.i_s_AB_A) || !std::isfinite(e.x.omega_mech_rad_s) ||
+      !std::isfinite(e.load_Nm)) {
+    trip(FaultCode::non_finite, k);
+  }
+  const T torque_Nm = modulating() ? electromagnetic_torque_Nm(e.x) : T(0);
+  if (oracle_ == nullptr &&
+      encoder_check_.failed(encoder_delta_counts_, e.x.omega_mech_rad_s, e.load_Nm, torque_Nm)) {
+    trip(FaultCode::encoder, k);
+  }
+  if (!modulating()) {
+    adc_stuck_check_.reset();
+    phase_loss_check_.reset();
+    return;
+  }
+  // While the inverter drives the motor.
+  if (!(v_bus_V >= T(p.bus_min_V))) trip(FaultCode::bus_undervoltage, k);  // NaN too
+  if (oracle_ == nullptr && adc_stuck_check_.stuck(sample.phase_code, u_written_V_)) {
+    trip(FaultCode::adc_stuck, k);
+  }
+  const T flux_angle_rad = pole_pairs_ * e.x.theta_mech_rad +
+                           std::atan2(e.x.flux_r_AB_Wb.y(), e.x.flux_r_AB_Wb.x());
+  const int lost = phase_loss_check_.lost_phase(phase_current_A_, flux_angle_rad);
+  if (lost >= 0) trip(FaultCode::phase_loss, k, uint8_t(lost));
+  const DriveState s = machine_.state();
+  if (config_.commands_over_can && command_timeout_ticks_ > 0 &&
+      (s == DriveState::magnetizing || s == DriveState::running) &&
+      k - last_command_tick_ > command_timeout_ticks_) {
+    trip(FaultCode::command_timeout, k);
+  }
+}
+
+template <typename T>
+control::Vec2<T> Drive<T>::control(uint64_t k, const Estimate& e, T v_bus_V) noexcept {
+  // --- predict over the latency, then choose v~ for the period it will act on.
+  const bool latency = config_.pwm_latency_ticks > 0 && config_.compensate_latency;
+  const bool stopping = machine_.state() == DriveState::stopping;
+  control::RotorFrameState<T> x = e.x;
+  if (latency) x = model_.predict(e.x, v_in_flight_V_, e.load_Nm);
+  x.theta_mech_rad = control::wrap_pi(x.theta_mech_rad);
+  // References at x's step (ref_now) and the step after (ref), the speed through the ramp.
+  // Until the drive runs, a limited ramp follows the estimate and an unlimited one the
+  // reference, so that the reaching law acts on the real error from the first running tick.
+  // Stopping ramps the speed to zero at the stop deceleration.
+  auto speed_target = [&](uint64_t tick) {
+    return stopping ? T(0) : T(references_.at_tick(tick).omega_mech_rad_s);
+  };
+  if (machine_.state() == DriveState::magnetizing) {
+    speed_ramp_.reset(speed_ramp_.limited() ? e.x.omega_mech_rad_s : speed_target(k));
+  }
+  const T ramp_k1 = speed_ramp_.next(speed_ramp_.value(), speed_target(k + 1));
+  Reference ref_now = references_.at_tick(k + (latency ? 1 : 0));
+  Reference ref = references_.at_tick(k + (latency ? 2 : 1));
+  ref_now.omega_mech_rad_s = double(latency ? ramp_k1 : speed_ramp_.value());
+  ref.omega_mech_rad_s = double(latency ? speed_ramp_.next(ramp_k1, speed_target(k + 2)) : ramp_k1);
+  if (stopping) ref_now.torque_Nm = ref.torque_Nm = 0.0;
+  speed_ramp_.reset(ramp_k1);
+  const control::InputDisk<T> feasible = feasible_inputs(x, v_bus_V);
+  Vec2 v = Vec2::Zero();
+  Vec2 i_command = Vec2::Zero();  // rotor-frame current command (magnetizing, iol)
+  if (machine_.state() == DriveState::magnetizing) {
+    if (magnetized_flux2(e.x) >= T(config_.magnetized_fraction) * magnetized_flux2_ref(ref)) {
+      machine_.go(DriveState::running, TransitionReason::magnetized, k);
+      iol_stage_.start(magnetizing_current(x, ref));
+    } else if (k - magnetizing_start_tick_ > magnetizing_timeout_ticks_) {
+      trip(FaultCode::magnetizing_timeout, k);
+    } else {
+      i_command = magnetizing_current(x, ref);
+      v = current_loop_.input(x.flux_r_AB_Wb, x.i_s_AB_A, i_command, feasible);
+    }
+  }
+  const DriveState s = machine_.state();
+  const bool controlling = s == DriveState::running || s == DriveState::stopping;
+  if (controlling && controller_ == ControllerKind::iol) {
+    Reference boundary_ref = references_.at_tick(k + uint64_t(iol_stage_.ticks_per_period()));
+    boundary_ref.omega_mech_rad_s = ref.omega_mech_rad_s;  // through the speed ramp
+    if (stopping) boundary_ref.torque_Nm = 0.0;
+    const IolTickResult<T> r = iol_stage_.tick(e.x.flux_r_AB_Wb, e.x.omega_mech_rad_s, boundary_ref);
+    if (r.status != control::IolStatus::ok) trip(FaultCode::singular_control, k);
+    i_command = r.i_cmd_AB_A;
+    record_.i_held_A_A = double(r.i_held_AB_A.x());
+    record_.i_held_B_A = double(r.i_held_AB_A.y());
+    v = current_loop_.input(x.flux_r_AB_Wb, x.i_s_AB_A, i_command, feasible);
+    record_.iol_boundary = r.boundary;
+    if (r.boundary) {
+      record_.torque_ref_Nm = double(r.torque_ref_Nm);
+      record_.torque_cmd_Nm = double(r.torque_cmd_Nm);
+      record_.y2 = double(r.y2);
+      record_.y2_ref = double(r.y2_ref);
+      record_.stator_flux2_est_Wb2 = double(r.flux2_s_Wb2);
+      record_.torque_limited = r.torque_limited;
+    }
+  } else if (controlling) {
+    control::DsmcInput<T> in;
+    in.flux_r_AB_Wb = x.flux_r_AB_Wb;
+    in.i_s_AB_A = x.i_s_AB_A;
+    in.omega_mech_rad_s = x.omega_mech_rad_s;
+    in.load_Nm = e.load_Nm;
+    in.omega_ref_rad_s = T(ref_now.omega_mech_rad_s);
+    in.omega_ref_next_rad_s = T(ref.omega_mech_rad_s);
+    in.flux2_ref_Wb2 = T(ref_now.flux2_Wb2);
+    in.flux2_ref_next_Wb2 = T(ref.flux2_Wb2);
+    in.feasible = feasible;
+    const control::DsmcOutput<T> out = dsmc_.step(in);
+    if (out.status != control::DsmcStatus::ok) trip(FaultCode::singular_control, k);
+    v = out.v_AB_V;
+    record_.discriminant = double(out.discriminant);
+    record_.c_k = double(out.c_k);
+    record_.det_B = double(out.det_B);
+    record_.speed_saturated = out.speed_saturated;
+    record_.flux_saturated = out.flux_saturated;
+  }
+  record_.omega_ref_rad_s = ref.omega_mech_rad_s;
+  record_.flux2_ref_Wb2 = ref.flux2_Wb2;
+  record_.controlled_flux2_ref_Wb2 = double(magnetized_flux2_ref(ref));
+
+  // --- inner feedback (2) and limits. The held voltage is rotated to the middle of the
+  // period it acts on, where the analog law's rotation is on average.
+  record_.i_cmd_A_A = double(i_command.x());
+  record_.i_cmd_B_A = double(i_command.y());
+  if (config_.current_source) {
+    if (!finite(i_command)) trip(FaultCode::non_finite, k);
+    if (machine_.state() != DriveState::fault && hw_.current_source != nullptr) {
+      hw_.current_source->set_current_AB_A(double(i_command.x()), double(i_command.y()));
+      hw_.pwm.enable();
+    }
+  } else if (config_.analog_inner_loop) {
+    if (!finite(v)) trip(FaultCode::non_finite, k);
+    if (machine_.state() != DriveState::fault && hw_.analog_inner_loop != nullptr) {
+      hw_.analog_inner_loop->set_input_AB_V(double(v.x()), double(v.y()));
+      hw_.pwm.enable();
+    }
+  } else {
+    const Vec2 compensation = compensation_AB(x);
+    const auto rotation = control::Rotation<T>::from_angle(
+        pole_pairs_ * (x.theta_mech_rad + x.omega_mech_rad_s * T(config_.sample_period_s / 2)));
+    const Vec2 u_alphabeta = rotation.apply(compensation + v);
+    const control::SvpwmResult<T> pwm = control::svpwm(u_alphabeta, v_bus_V);
+    record_.voltage_clipped = pwm.clipped;
+    if (pwm.clipped) {  // the observers must see what is actually applied
+      const T limit = control::svpwm_linear_limit_V(v_bus_V);
+      const T magnitude = u_alphabeta.norm();
+      v = rotation.apply_inverse(u_alphabeta * (magnitude > limit ? limit / magnitude : T(1))) -
+          compensation;
+    }
+    record_.u_alpha_V = double(u_alphabeta.x());
+    record_.u_beta_V = double(u_alphabeta.y());
+    if (!finite(u_alphabeta) || !finite(v)) trip(FaultCode::non_finite, k);
+    if (machine_.state() != DriveState::fault) {
+      hw_.pwm.set_duties({float(pwm.duty[0]), float(pwm.duty[1]), float(pwm.duty[2])});
+      hw_.pwm.enable();
+      u_written_V_ = u_alphabeta;
+    }
+  }
+  if (machine_.state() == DriveState::fault) return Vec2::Zero();
+
+  // --- a stop is complete once the ramp is at zero and the motor (nearly) still.
+  if (stopping && ((speed_ramp_.value() == T(0) &&
+                    std::abs(e.x.omega_mech_rad_s) < T(config_.stop_speed_rad_s)) ||
+                   k - stop_start_tick_ > stop_timeout_ticks_)) {
+    hw_.pwm.disable();
+    machine_.go(DriveState::idle, TransitionReason::stopped, k);
+    return Vec2::Zero();
+  }
+  return v;
 }
 
 template <typename T>
@@ -195,137 +422,26 @@ void Drive<T>::on_tick() noexcept {
   record_.iol_boundary = false;
 
   const hal::AdcSample sample = hw_.adc.sample();
-  if (state_ == DriveState::fault) {
-    hw_.pwm.disable();
-  } else if (state_ == DriveState::calibrating) {
+  receive_commands(k);
+  if (machine_.state() == DriveState::calibrating) {
     if (calibrate_adc(sample)) {
-      state_ = DriveState::magnetizing;
-      magnetizing_start_tick_ = k + 1;
+      machine_.go(DriveState::idle, TransitionReason::calibrated, k);
+      if (config_.auto_enable) enable(k + 1);
     }
   } else {
-    // --- sense and estimate
+    // --- sense, estimate, check
     const T v_bus_V = T(sample.bus_code) * T(hw_.adc.scale().bus_V_per_code);
     const Estimate e = estimate(sample);
-    if (peak_phase_current_A_ > T(config_.overcurrent_trip_A) || adc_saturated_) {
-      trip(FaultCode::overcurrent);
-    }
-    if (!(v_bus_V >= T(config_.bus_min_V))) trip(FaultCode::bus_undervoltage);  // NaN too
-    if (v_bus_V > T(config_.bus_max_V)) trip(FaultCode::bus_overvoltage);
-    // --- control: predict over the latency, then choose v~ for the period it will act on.
-    const bool latency = config_.pwm_latency_ticks > 0 && config_.compensate_latency;
-    control::RotorFrameState<T> x = e.x;
-    if (latency) x = model_.predict(e.x, v_in_flight_V_, e.load_Nm);
-    x.theta_mech_rad = control::wrap_pi(x.theta_mech_rad);
-    // References at x's step (ref_now) and the step after (ref), the speed through the ramp.
-    // Until the drive runs, a limited ramp follows the estimate and an unlimited one the
-    // reference, so that the reaching law acts on the real error from the first running tick.
-    if (state_ != DriveState::running) {
-      speed_ramp_.reset(speed_ramp_.limited() ? e.x.omega_mech_rad_s
-                                              : T(references_.at_tick(k).omega_mech_rad_s));
-    }
-    const T ramp_k1 =
-        speed_ramp_.next(speed_ramp_.value(), T(references_.at_tick(k + 1).omega_mech_rad_s));
-    Reference ref_now = references_.at_tick(k + (latency ? 1 : 0));
-    Reference ref = references_.at_tick(k + (latency ? 2 : 1));
-    ref_now.omega_mech_rad_s = double(latency ? ramp_k1 : speed_ramp_.value());
-    ref.omega_mech_rad_s =
-        double(latency ? speed_ramp_.next(ramp_k1, T(ref.omega_mech_rad_s)) : ramp_k1);
-    speed_ramp_.reset(ramp_k1);
-    const control::InputDisk<T> feasible = feasible_inputs(x, v_bus_V);
+    protect(k, e, sample, v_bus_V);
     Vec2 v = Vec2::Zero();
-    Vec2 i_command = Vec2::Zero();  // rotor-frame current command (magnetizing, iol)
-    if (state_ == DriveState::magnetizing) {
-      if (magnetized_flux2(e.x) >= T(config_.magnetized_fraction) * magnetized_flux2_ref(ref)) {
-        state_ = DriveState::running;
-        iol_stage_.start(magnetizing_current(x, ref));
-      } else if (double(k - magnetizing_start_tick_) * config_.sample_period_s >
-                 config_.magnetizing_timeout_s) {
-        trip(FaultCode::magnetizing_timeout);
-      } else {
-        i_command = magnetizing_current(x, ref);
-        v = current_loop_.input(x.flux_r_AB_Wb, x.i_s_AB_A, i_command, feasible);
-      }
-    }
-    if (state_ == DriveState::running && config_.controller == ControllerKind::iol) {
-      Reference boundary_ref = references_.at_tick(k + uint64_t(iol_stage_.ticks_per_period()));
-      boundary_ref.omega_mech_rad_s = ref.omega_mech_rad_s;  // through the speed ramp
-      const IolTickResult<T> r =
-          iol_stage_.tick(e.x.flux_r_AB_Wb, e.x.omega_mech_rad_s, boundary_ref);
-      if (r.status != control::IolStatus::ok) trip(FaultCode::singular_control);
-      i_command = r.i_cmd_AB_A;
-      record_.i_held_A_A = double(r.i_held_AB_A.x());
-      record_.i_held_B_A = double(r.i_held_AB_A.y());
-      v = current_loop_.input(x.flux_r_AB_Wb, x.i_s_AB_A, i_command, feasible);
-      record_.iol_boundary = r.boundary;
-      if (r.boundary) {
-        record_.torque_ref_Nm = double(r.torque_ref_Nm);
-        record_.torque_cmd_Nm = double(r.torque_cmd_Nm);
-        record_.y2 = double(r.y2);
-        record_.y2_ref = double(r.y2_ref);
-        record_.stator_flux2_est_Wb2 = double(r.flux2_s_Wb2);
-        record_.torque_limited = r.torque_limited;
-      }
-    } else if (state_ == DriveState::running) {
-      control::DsmcInput<T> in;
-      in.flux_r_AB_Wb = x.flux_r_AB_Wb;
-      in.i_s_AB_A = x.i_s_AB_A;
-      in.omega_mech_rad_s = x.omega_mech_rad_s;
-      in.load_Nm = e.load_Nm;
-      in.omega_ref_rad_s = T(ref_now.omega_mech_rad_s);
-      in.omega_ref_next_rad_s = T(ref.omega_mech_rad_s);
-      in.flux2_ref_Wb2 = T(ref_now.flux2_Wb2);
-      in.flux2_ref_next_Wb2 = T(ref.flux2_Wb2);
-      in.feasible = feasible;
-      const control::DsmcOutput<T> out = dsmc_.step(in);
-      if (out.status != control::DsmcStatus::ok) trip(FaultCode::singular_control);
-      v = out.v_AB_V;
-      record_.discriminant = double(out.discriminant);
-      record_.c_k = double(out.c_k);
-      record_.det_B = double(out.det_B);
-      record_.speed_saturated = out.speed_saturated;
-      record_.flux_saturated = out.flux_saturated;
-    }
-    record_.omega_ref_rad_s = ref.omega_mech_rad_s;
-    record_.flux2_ref_Wb2 = ref.flux2_Wb2;
-
-    // --- inner feedback (2) and limits. The held voltage is rotated to the middle of the
-    // period it acts on, where the analog law's rotation is on average.
-    record_.i_cmd_A_A = double(i_command.x());
-    record_.i_cmd_B_A = double(i_command.y());
-    if (config_.current_source) {
-      if (!finite(i_command)) trip(FaultCode::non_finite);
-      if (state_ != DriveState::fault && hw_.current_source != nullptr) {
-        hw_.current_source->set_current_AB_A(double(i_command.x()), double(i_command.y()));
-        hw_.pwm.enable();
-      }
-    } else if (config_.analog_inner_loop) {
-      if (!finite(v)) trip(FaultCode::non_finite);
-      if (state_ != DriveState::fault && hw_.analog_inner_loop != nullptr) {
-        hw_.analog_inner_loop->set_input_AB_V(double(v.x()), double(v.y()));
-        hw_.pwm.enable();
-      }
+    if (modulating()) {
+      v = control(k, e, v_bus_V);
     } else {
-      const Vec2 compensation = compensation_AB(x);
-      const auto rotation = control::Rotation<T>::from_angle(
-          pole_pairs_ * (x.theta_mech_rad + x.omega_mech_rad_s * T(config_.sample_period_s / 2)));
-      const Vec2 u_alphabeta = rotation.apply(compensation + v);
-      const control::SvpwmResult<T> pwm = control::svpwm(u_alphabeta, v_bus_V);
-      record_.voltage_clipped = pwm.clipped;
-      if (pwm.clipped) {  // the observers must see what is actually applied
-        const T limit = control::svpwm_linear_limit_V(v_bus_V);
-        const T magnitude = u_alphabeta.norm();
-        v = rotation.apply_inverse(u_alphabeta * (magnitude > limit ? limit / magnitude : T(1))) -
-            compensation;
-      }
-      record_.u_alpha_V = double(u_alphabeta.x());
-      record_.u_beta_V = double(u_alphabeta.y());
-      if (!finite(u_alphabeta) || !finite(v)) trip(FaultCode::non_finite);
-      if (state_ != DriveState::fault) {
-        hw_.pwm.set_duties({float(pwm.duty[0]), float(pwm.duty[1]), float(pwm.duty[2])});
-        hw_.pwm.enable();
-      }
+      hw_.pwm.disable();
+      record_.u_alpha_V = record_.u_beta_V = 0.0;
+      u_written_V_ = Vec2::Zero();
     }
-    if (state_ == DriveState::fault) v = Vec2::Zero();
+    if (!hw_.pwm.enabled()) v = Vec2::Zero();
 
     // --- advance the observers over the period [k, k+1] with the input acting on it.
     const Vec2 acting = config_.pwm_latency_ticks > 0 ? v_in_flight_V_ : v;
@@ -339,21 +455,30 @@ void Drive<T>::on_tick() noexcept {
     record_.flux_est_A_Wb = double(e.x.flux_r_AB_Wb.x());
     record_.flux_est_B_Wb = double(e.x.flux_r_AB_Wb.y());
     record_.flux2_est_Wb2 = double(e.x.flux_r_AB_Wb.squaredNorm());
+    record_.controlled_flux2_Wb2 = double(magnetized_flux2(e.x));
     record_.load_est_Nm = double(e.load_Nm);
+    record_.i_A_A = double(e.x.i_s_AB_A.x());
+    record_.i_B_A = double(e.x.i_s_AB_A.y());
     record_.v_bus_V = double(v_bus_V);
     record_.v_A_V = double(v.x());
     record_.v_B_V = double(v.y());
   }
-  record_.state = state_;
-  record_.fault = fault_;
   const uint64_t exec_ns = hw_.timer.execution_clock_ns() - start_ns;
   record_.exec_ns = static_cast<uint32_t>(std::min<uint64_t>(exec_ns, UINT32_MAX));
   execution_.add(record_.exec_ns);
-  if (config_.tick_budget_ns > 0 && record_.exec_ns > config_.tick_budget_ns) {
+  const uint32_t budget_ns = config_.protection.tick_budget_ns;
+  if (budget_ns > 0 && record_.exec_ns > budget_ns) {
     ++execution_.overruns;
-    trip(FaultCode::overrun);  // the PWM is off before the next period starts
-    record_.state = state_;
-    record_.fault = fault_;
+    trip(FaultCode::overrun, k);  // the PWM is off before the next period starts
+  }
+  status_.state = machine_.state();
+  status_.command_counter = decoder_.last_counter();
+  status_.rejected_commands = decoder_.rejected_total();
+  record_.state = status_.state;
+  record_.fault = status_.first_fault;
+  record_.fault_bits = status_.fault_bits;
+  if (hw_.can != nullptr) {
+    telemetry_.publish(k, *hw_.can, record_, status_, machine_, execution_, budget_ns);
   }
 }
 

@@ -3,8 +3,11 @@
 ///   sense (ADC, encoder) -> estimate (observers, rotation into the rotor frame) -> control
 ///   (magnetizing current or DSMC, one-step prediction over the PWM latency) -> inner feedback
 ///   (2) executed digitally -> limits -> SVPWM -> protection -> PWM write -> record.
-/// Start-up: ADC offset calibration with the PWM off, then magnetizing (B_k is singular at zero
-/// flux), then running. A fault turns the PWM off in the same tick and latches.
+/// States (firmware/state_machine.hpp): ADC offset calibration with the PWM off, idle until
+/// enabled, magnetizing (B_k is singular at zero flux), running, stopping on a disable command.
+/// Every protection check runs before the PWM write; a fault turns the PWM off in the same tick
+/// and latches until a clear_faults command. Commands arrive on CAN (bounded per tick) and
+/// telemetry leaves through the CAN transmit queue (docs/can/protocol.md, docs/safety.md).
 /// T is the control arithmetic: float on the MCU, double on the host.
 #include <cstdint>
 
@@ -15,14 +18,23 @@
 #include "control/flux_observer.hpp"
 #include "control/load_estimator.hpp"
 #include "control/motor_parameters.hpp"
+#include "firmware/commanded_reference.hpp"
 #include "firmware/drive_config.hpp"
+#include "firmware/drive_state.hpp"
 #include "firmware/execution_stats.hpp"
 #include "firmware/iol_stage.hpp"
+#include "firmware/protection/adc_stuck_check.hpp"
+#include "firmware/protection/encoder_check.hpp"
+#include "firmware/protection/phase_loss_check.hpp"
+#include "firmware/protocol/commands.hpp"
 #include "firmware/reference_source.hpp"
 #include "firmware/speed_ramp.hpp"
+#include "firmware/state_machine.hpp"
 #include "firmware/state_oracle.hpp"
+#include "firmware/telemetry.hpp"
 #include "firmware/tick_record.hpp"
 #include "hal/analog_inner_loop.hpp"
+#include "hal/can_bus.hpp"
 #include "hal/control_timer.hpp"
 #include "hal/current_adc.hpp"
 #include "hal/current_source.hpp"
@@ -38,20 +50,27 @@ struct DrivePeripherals {
   hal::ControlTimer& timer;
   hal::AnalogInnerLoop* analog_inner_loop = nullptr;  ///< only with config.analog_inner_loop
   hal::CurrentSource* current_source = nullptr;       ///< only with config.current_source
+  hal::CanBus* can = nullptr;  ///< commands and telemetry; without it the drive is local only
 };
 
 template <typename T>
 class Drive final : public hal::TickHandler {
  public:
-  /// Wires the drive; no allocation after this. `oracle` (simulation only) gives ideal sensors.
+  /// Wires the drive; no allocation after this. `references` is used unless the config takes
+  /// them from CAN commands. `oracle` (simulation only) gives ideal sensors.
   Drive(const control::MotorParameters& motor, const DriveConfig& config,
         const DrivePeripherals& peripherals, const ReferenceSource& references,
         const StateOracle* oracle = nullptr);
 
   void on_tick() noexcept override;
 
-  DriveState state() const noexcept { return state_; }
-  FaultCode fault() const noexcept { return fault_; }
+  DriveState state() const noexcept { return machine_.state(); }
+  /// The first latched fault (none when not faulted).
+  FaultCode fault() const noexcept { return status_.first_fault; }
+  const DriveStatus& status() const noexcept { return status_; }
+  const StateMachine& state_machine() const noexcept { return machine_; }
+  const protocol::CommandDecoder& commands() const noexcept { return decoder_; }
+  const Telemetry& telemetry() const noexcept { return telemetry_; }
   const TickRecord& record() const noexcept { return record_; }
   const ExecutionStats& execution() const noexcept { return execution_; }
 
@@ -65,6 +84,16 @@ class Drive final : public hal::TickHandler {
 
   bool calibrate_adc(const hal::AdcSample& sample) noexcept;
   Estimate estimate(const hal::AdcSample& sample) noexcept;
+  /// The checks on what was sensed and estimated this tick (docs/safety.md).
+  void protect(uint64_t k, const Estimate& e, const hal::AdcSample& sample, T v_bus_V) noexcept;
+  /// Magnetizing, running or stopping: the control law, limits and the PWM write. Returns the
+  /// rotor-frame v~ that will act (zero if a check tripped).
+  Vec2 control(uint64_t k, const Estimate& e, T v_bus_V) noexcept;
+  // Commands (drive_commands.cpp).
+  void receive_commands(uint64_t k) noexcept;
+  protocol::CommandResult apply(const protocol::Command& command, uint64_t k) noexcept;
+  void enable(uint64_t k) noexcept;
+  void clear_faults(uint64_t k) noexcept;
   control::InputDisk<T> feasible_inputs(const control::RotorFrameState<T>& x,
                                         T v_bus_V) const noexcept;
   /// The magnetizing current: along the flux (the A axis while there is none), of the size that
@@ -75,11 +104,15 @@ class Drive final : public hal::TickHandler {
   T magnetized_flux2(const control::RotorFrameState<T>& x) const noexcept;
   T magnetized_flux2_ref(const Reference& ref) const noexcept;
   Vec2 compensation_AB(const control::RotorFrameState<T>& x) const noexcept;
-  void trip(FaultCode code) noexcept;
+  /// Turns the PWM off and latches the fault (the first one keeps its code and time).
+  void trip(FaultCode code, uint64_t k, uint8_t detail = 0) noexcept;
+  bool modulating() const noexcept;
+  T electromagnetic_torque_Nm(const control::RotorFrameState<T>& x) const noexcept;
 
   DriveConfig config_;
   DrivePeripherals hw_;
-  const ReferenceSource& references_;
+  CommandedReference commanded_;
+  const ReferenceSource& references_;  ///< commanded_ or the profile given at construction
   const StateOracle* oracle_;
 
   control::ExactModel000Coefficients coefficients_;
@@ -92,10 +125,21 @@ class Drive final : public hal::TickHandler {
   SpeedRamp<T> speed_ramp_;
   IolStage<T> iol_stage_;
   T sigma_H_, beta_per_H_, pole_pairs_, Lm_H_, Ls_H_, Lm_over_Lr_, a21_, a22_, b2_;
+  T torque_per_AWb_;  ///< k_T p Lm / Lr
 
-  DriveState state_ = DriveState::calibrating;
-  FaultCode fault_ = FaultCode::none;
-  uint64_t magnetizing_start_tick_ = 0;
+  StateMachine machine_;
+  DriveStatus status_;
+  ControllerKind controller_;
+  protocol::CommandDecoder decoder_;
+  Telemetry telemetry_;
+  EncoderCheck<T> encoder_check_;
+  AdcStuckCheck<T> adc_stuck_check_;
+  PhaseLossCheck<T> phase_loss_check_;
+  uint64_t magnetizing_start_tick_ = 0, magnetizing_timeout_ticks_ = 0;
+  uint64_t last_command_tick_ = 0, command_timeout_ticks_ = 0;
+  uint64_t stop_start_tick_ = 0, stop_timeout_ticks_ = 0;
+  int32_t encoder_delta_counts_ = 0;   ///< counts over the last period
+  Vec2 u_written_V_ = Vec2::Zero();     ///< last stator voltage command (alpha-beta)
   int calibration_count_ = 0;
   int64_t calibration_sum_[3] = {0, 0, 0};
   T offset_code_[3] = {T(0), T(0), T(0)};
@@ -104,6 +148,7 @@ class Drive final : public hal::TickHandler {
   bool encoder_started_ = false;       ///< the first reading has set the observer's angle
   Vec2 v_in_flight_V_ = Vec2::Zero();  ///< written last tick, acts over this period (latency 1)
   T peak_phase_current_A_ = T(0);      ///< largest phase current of this tick
+  T phase_current_A_[3] = {T(0), T(0), T(0)};
   bool adc_saturated_ = false;         ///< a phase-current code on a rail this tick
   TickRecord record_;
   ExecutionStats execution_;

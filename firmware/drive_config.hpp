@@ -1,7 +1,10 @@
 #pragma once
 /// Configuration of the drive application. In-class defaults are safe for the paper-000 motor;
 /// scenario and board files override them (validated on load).
+#include <cstdint>
 #include <limits>
+
+#include "firmware/protection/protection_config.hpp"
 
 namespace imd::firmware {
 
@@ -60,11 +63,24 @@ struct DriveConfig {
   double load_estimator_pole = 0.99;  ///< double pole of the error matrix (13)
   double min_flux2_Wb2 = 1e-3;        ///< below it B_k counts as singular
 
-  // Protection (the full set comes with the drive application).
-  double overcurrent_trip_A = std::numeric_limits<double>::infinity();
-  double bus_min_V = 20.0;      ///< below: undervoltage (also a NaN reading)
-  double bus_max_V = 450.0;     ///< above: overvoltage
-  uint32_t tick_budget_ns = 0;  ///< execution-time budget; 0: not checked (simulation)
+  ProtectionConfig protection;
+
+  // Commands and telemetry (docs/can/protocol.md).
+  uint8_t node_id = 1;
+  /// References from CAN commands (set_speed, set_flux) with the command watchdog; otherwise
+  /// from the ReferenceSource given at construction (a scenario profile).
+  bool commands_over_can = false;
+  /// Enable once calibrated, without a command (scenario profiles).
+  bool auto_enable = false;
+  int telemetry_rate_Hz = 100;  ///< fast telemetry, 10..1000
+  double max_flux2_Wb2 = 4.0;   ///< largest set_flux accepted
+  /// Initial references over CAN, before any set_speed or set_flux.
+  double flux2_ref_Wb2 = 0.2, stator_flux2_ref_Wb2 = 1.0;
+
+  // Disable: ramp to a stop, then PWM off.
+  double stop_decel_rad_s2 = 200.0;
+  double stop_speed_rad_s = 1.0;  ///< PWM off once the ramp is at 0 and |speed| below this
+  double stop_timeout_s = 10.0;   ///< PWM off after this even if the motor still turns
 };
 
 }  // namespace imd::firmware

@@ -14,6 +14,10 @@ class SpeedRamp {
   SpeedRamp(double max_accel_rad_s2, double period_s) noexcept
       : max_step_(T(max_accel_rad_s2 * period_s)) {}
 
+  /// Changes the acceleration limit (the stop ramp uses its own).
+  void set_max_accel(double max_accel_rad_s2, double period_s) noexcept {
+    max_step_ = T(max_accel_rad_s2 * period_s);
+  }
   T value() const noexcept { return value_; }
   bool limited() const noexcept { return std::isfinite(max_step_); }
   void reset(T omega_rad_s) noexcept { value_ = omega_rad_s; }

@@ -3,57 +3,24 @@
 /// simulation's CSV. Plain data, copied once per tick.
 #include <cstdint>
 
+#include "firmware/drive_state.hpp"
+
 namespace imd::firmware {
-
-enum class DriveState : uint8_t { calibrating, magnetizing, running, fault };
-
-enum class FaultCode : uint8_t {
-  none = 0,
-  adc_offset,  ///< offset out of range at start-up
-  overcurrent,
-  magnetizing_timeout,
-  non_finite,        ///< NaN or Inf in the duty path
-  singular_control,  ///< B_k singular while running
-  bus_undervoltage,
-  bus_overvoltage,
-  overrun,  ///< the tick took longer than its budget
-};
-
-/// Stable lower-case name of a fault code, for logs and summaries.
-constexpr const char* fault_name(FaultCode code) noexcept {
-  switch (code) {
-    case FaultCode::none:
-      return "none";
-    case FaultCode::adc_offset:
-      return "adc_offset";
-    case FaultCode::overcurrent:
-      return "overcurrent";
-    case FaultCode::magnetizing_timeout:
-      return "magnetizing_timeout";
-    case FaultCode::non_finite:
-      return "non_finite";
-    case FaultCode::singular_control:
-      return "singular_control";
-    case FaultCode::bus_undervoltage:
-      return "bus_undervoltage";
-    case FaultCode::bus_overvoltage:
-      return "bus_overvoltage";
-    case FaultCode::overrun:
-      return "overrun";
-  }
-  return "unknown";
-}
 
 struct TickRecord {
   uint64_t tick = 0;
   DriveState state = DriveState::calibrating;
-  FaultCode fault = FaultCode::none;
+  FaultCode fault = FaultCode::none;  ///< the first latched fault
+  uint16_t fault_bits = 0;           ///< every latched fault, bit n = code n
   // Estimates (rotor frame) at this tick.
   double omega_est_rad_s = 0.0, theta_est_rad = 0.0, flux2_est_Wb2 = 0.0, load_est_Nm = 0.0;
   double flux_est_A_Wb = 0.0, flux_est_B_Wb = 0.0;
   double i_alpha_A = 0.0, i_beta_A = 0.0, v_bus_V = 0.0;
+  double i_A_A = 0.0, i_B_A = 0.0;  ///< estimated stator current, rotor frame
   // References the law aimed at (for the step the input acts on).
   double omega_ref_rad_s = 0.0, flux2_ref_Wb2 = 0.0;
+  /// The flux the selected controller regulates: rotor flux (dsmc) or stator flux (iol).
+  double controlled_flux2_Wb2 = 0.0, controlled_flux2_ref_Wb2 = 0.0;
   // Command.
   double v_A_V = 0.0, v_B_V = 0.0;         ///< v~ applied (after limiting)
   double u_alpha_V = 0.0, u_beta_V = 0.0;  ///< stator voltage command

@@ -24,8 +24,12 @@ def load(path):
     return data
 
 
+# The drive state numbers of firmware/drive_state.hpp (the CAN protocol's).
+RUNNING = 3
+
+
 def running_start(d):
-    running = np.nonzero(d["state"] == 2)[0]
+    running = np.nonzero(d["state"] == RUNNING)[0]
     return d["t_s"][running[0]] if running.size else d["t_s"][0]
 
 

@@ -8,6 +8,7 @@
 #include "control/exact_model_001.hpp"
 #include "hal_sim/scenario.hpp"
 #include "test_motors.hpp"
+#include "firmware/drive_state.hpp"
 #include "tools/drive_sim/scenario_run.hpp"
 
 namespace imd::sim {
@@ -87,7 +88,7 @@ TEST(Seed001Paper, MetricsAndStartUpAreRight) {
   const Scenario s = scenario("seed001_paper.toml", {"drive.magnetized_fraction=0.5"});
   double magnetizing_current = 0.0;
   run_scenario(s, {[&](const SimRow& row) {
-                     if (row.state == 1 && row.t_s > 0.01) {
+                     if (row.state == int(imd::firmware::DriveState::magnetizing) && row.t_s > 0.01) {
                        magnetizing_current = std::hypot(row.i_alpha_A, row.i_beta_A);
                      }
                    },

@@ -55,8 +55,10 @@ void run_without_allocation() {
   board_config.adc.noise_A = 0.01;
   sim::SimBoard board(test::test_motors()[0].parameters, board_config);
   DriveConfig config;
+  config.auto_enable = true;              // no enable command on this bench
+  config.protection.tick_budget_ns = 0;  // wall-clock time on a shared host is not the MCU's
   config.i_max_A = 6.0;
-  config.overcurrent_trip_A = 9.0;
+  config.protection.overcurrent_A = 9.0;
   config.speed_reaching_pole = config.flux_reaching_pole = 0.98;
   const Constant references;
   Drive<T> drive(test::test_motors()[0].parameters, config,
@@ -79,8 +81,10 @@ TEST(DriveTick, NeverAllocatesInFloat) {
 TEST(DriveTick, OvercurrentTurnsThePwmOffInTheSameTick) {
   sim::SimBoard board(test::test_motors()[0].parameters, {});
   DriveConfig config;
+  config.auto_enable = true;              // no enable command on this bench
+  config.protection.tick_budget_ns = 0;  // wall-clock time on a shared host is not the MCU's
   config.i_max_A = 6.0;
-  config.overcurrent_trip_A = 9.0;
+  config.protection.overcurrent_A = 9.0;
   const Constant references;
   Drive<double> drive(test::test_motors()[0].parameters, config,
                       {board.pwm(), board.encoder(), board.adc(), board.timer()}, references);
@@ -117,8 +121,12 @@ TEST(DriveTick, BusUnderAndOvervoltageTrip) {
     sim::SimBoardConfig board_config;
     board_config.v_bus_V = bus_V;
     DriveConfig config;
-    config.bus_min_V = 200.0;
-    config.bus_max_V = 450.0;
+    config.auto_enable = true;
+    config.protection.tick_budget_ns = 0;
+  config.auto_enable = true;              // no enable command on this bench
+  config.protection.tick_budget_ns = 0;  // wall-clock time on a shared host is not the MCU's
+    config.protection.bus_min_V = 200.0;
+    config.protection.bus_max_V = 450.0;
     Rig rig(board_config, config);
     for (int k = 0; k < 300; ++k) rig.board.run_tick();  // past the offset calibration
     EXPECT_EQ(rig.drive.fault(),
@@ -129,7 +137,9 @@ TEST(DriveTick, BusUnderAndOvervoltageTrip) {
 
 TEST(DriveTick, OverrunTrips) {
   DriveConfig config;
-  config.tick_budget_ns = 1;  // no tick runs in 1 ns
+  config.auto_enable = true;              // no enable command on this bench
+  config.protection.tick_budget_ns = 0;  // wall-clock time on a shared host is not the MCU's
+  config.protection.tick_budget_ns = 1;  // no tick runs in 1 ns
   Rig rig({}, config);
   for (int k = 0; k < 300; ++k) rig.board.run_tick();
   EXPECT_EQ(rig.drive.fault(), FaultCode::overrun);

@@ -77,9 +77,12 @@ firmware::DriveConfig drive_config(const Scenario& s) {
   c.max_accel_rad_s2 = s.max_accel_rad_s2;
   c.speed_reaching_pole = s.speed_reaching_pole;
   c.flux_reaching_pole = s.flux_reaching_pole;
-  c.overcurrent_trip_A = 1.5 * s.i_max_A;
-  c.bus_min_V = 0.7 * s.v_bus_V;  // +-30 % of the nominal bus
-  c.bus_max_V = 1.3 * s.v_bus_V;
+  c.auto_enable = true;
+  c.protection.overcurrent_A = 1.5 * s.i_max_A;
+  c.protection.bus_min_V = 0.7 * s.v_bus_V;  // +-30 % of the nominal bus
+  c.protection.bus_max_V = 1.3 * s.v_bus_V;
+  // Lock-step simulation: the host's wall-clock time per tick is not the MCU's.
+  c.protection.tick_budget_ns = 0;
   c.adc_calibration_ticks = s.ideal_sensors ? 0 : 256;
   c.adc_offset_limit_A = 0.02 * s.adc.full_scale_A;  // 2 % of full scale (0.2 A on 10 A)
   c.section_iv_load_estimator = s.section_iv;

@@ -1,0 +1,74 @@
+#pragma once
+/// Encoder plausibility. Two failures are caught:
+///  - a jump: more counts in one tick than 1.5 x the overspeed limit could produce;
+///  - silence: no count while the motion model says the rotor has turned by more than
+///    `missing_counts`. The model starts from the estimated speed and load at the last count
+///    and integrates the electromagnetic torque the drive applies, so a rotor that is braked to
+///    a stop, or held at standstill, predicts no motion. It is re-anchored every `window_s`:
+///    an estimation bias b then shifts the prediction by at most b window^2 / (2 J).
+/// Tick context, no heap.
+#include <cmath>
+#include <cstdint>
+#include <numbers>
+
+namespace imd::firmware {
+
+template <typename T>
+class EncoderCheck {
+ public:
+  struct Config {
+    double counts_per_rev = 8192.0;
+    double period_s = 1e-4;
+    double J_kgm2 = 0.01;
+    double friction_Nms = 0.0;
+    double missing_counts = 6.0;
+    double window_s = 0.01;
+    double overspeed_rad_s = 400.0;
+  };
+
+  explicit EncoderCheck(const Config& c) noexcept
+      : period_s_(T(c.period_s)),
+        per_J_(T(1.0 / c.J_kgm2)),
+        friction_(T(c.friction_Nms)),
+        missing_rad_(T(c.missing_counts * 2.0 * std::numbers::pi / c.counts_per_rev)),
+        window_ticks_(static_cast<uint32_t>(std::ceil(c.window_s / c.period_s))),
+        max_jump_counts_(static_cast<int32_t>(
+            std::ceil(1.5 * c.overspeed_rad_s * c.period_s * c.counts_per_rev /
+                      (2.0 * std::numbers::pi))) +
+                         2) {
+    reset();
+  }
+
+  /// Forget the history (after the encoder was (re)started or a fault was cleared).
+  void reset() noexcept { silent_ticks_ = window_ticks_; }
+
+  /// One tick: the counts seen over the last period, and the drive's estimates now.
+  /// `torque_Nm` is the electromagnetic torque over the coming period. True if the encoder has
+  /// failed.
+  bool failed(int32_t delta_counts, T omega_est_rad_s, T load_est_Nm, T torque_Nm) noexcept {
+    if (delta_counts > max_jump_counts_ || delta_counts < -max_jump_counts_) return true;
+    // The model predicted `travel_rad_` over the silence so far.
+    if (delta_counts == 0 && std::abs(travel_rad_) > missing_rad_) return true;
+    if (delta_counts != 0 || silent_ticks_ >= window_ticks_) {  // anchor to the estimate
+      omega_rad_s_ = omega_est_rad_s;
+      load_Nm_ = load_est_Nm;
+      travel_rad_ = T(0);
+      silent_ticks_ = 0;
+    }
+    ++silent_ticks_;
+    travel_rad_ += omega_rad_s_ * period_s_;
+    omega_rad_s_ += (torque_Nm - load_Nm_ - friction_ * omega_rad_s_) * per_J_ * period_s_;
+    return false;
+  }
+
+  int32_t max_jump_counts() const noexcept { return max_jump_counts_; }
+
+ private:
+  T period_s_, per_J_, friction_, missing_rad_;
+  uint32_t window_ticks_;
+  int32_t max_jump_counts_;
+  uint32_t silent_ticks_ = 0;
+  T omega_rad_s_ = T(0), load_Nm_ = T(0), travel_rad_ = T(0);
+};
+
+}  // namespace imd::firmware

@@ -1,0 +1,31 @@
+#pragma once
+/// Protection thresholds. Every check runs each tick before the PWM write; the defaults are safe
+/// for the paper-000 motor on a 311 V bus and are overridden per board or scenario
+/// (docs/safety.md explains each check and its detection latency).
+#include <cstdint>
+#include <limits>
+
+namespace imd::firmware {
+
+struct ProtectionConfig {
+  double overcurrent_A = 10.0;  ///< instantaneous, per phase (and any ADC code on a rail)
+  double bus_min_V = 20.0;      ///< below: undervoltage while enabled (also a NaN reading)
+  double bus_max_V = 450.0;     ///< above: overvoltage, in every state
+  double overspeed_rad_s = 400.0;  ///< |estimated mechanical speed| above: overspeed
+  /// Encoder: counts the motion model predicts within one window without a count being seen.
+  double encoder_missing_counts = 6.0;
+  double encoder_window_s = 0.01;  ///< the model is re-anchored to the estimate after this
+  /// ADC stuck: ticks with identical phase codes while the applied voltage should have moved
+  /// the current by several codes.
+  int adc_stuck_ticks = 20;
+  /// Phase loss: over one revolution of the flux, a phase's mean |i| below this share of the
+  /// largest phase's, while that one carries at least phase_loss_min_current_A.
+  double phase_loss_ratio = 0.3;
+  double phase_loss_min_current_A = 0.5;
+  double phase_loss_max_window_s = 1.0;  ///< a slower revolution is not judged
+  /// Command watchdog while magnetizing or running on CAN commands; 0 disables it.
+  double command_timeout_s = 0.2;
+  uint32_t tick_budget_ns = 90'000;  ///< execution-time budget; 0: not checked
+};
+
+}  // namespace imd::firmware

@@ -1,0 +1,74 @@
+#pragma once
+/// The drive's state machine:
+///   calibrating -> idle -> magnetizing -> running -> stopping -> idle
+///   any state -> fault -> idle (only by clear_faults)
+/// Every transition is checked against this graph, counted, and kept in a short log that the
+/// telemetry reports as state_change frames. No heap; tick context.
+#include <array>
+#include <cstdint>
+
+#include "firmware/drive_state.hpp"
+
+namespace imd::firmware {
+
+struct Transition {
+  uint64_t tick = 0;
+  DriveState from = DriveState::calibrating, to = DriveState::calibrating;
+  TransitionReason reason = TransitionReason::calibrated;
+};
+
+class StateMachine {
+ public:
+  static constexpr std::size_t kLogDepth = 16;
+
+  DriveState state() const noexcept { return state_; }
+
+  /// Moves to `to` if the graph allows it; false (and nothing changes) otherwise.
+  bool go(DriveState to, TransitionReason reason, uint64_t tick) noexcept {
+    if (!allowed(state_, to)) return false;
+    log_[count_ % kLogDepth] = {tick, state_, to, reason};
+    ++count_;
+    ++entered_[static_cast<int>(to)];
+    state_ = to;
+    return true;
+  }
+
+  static constexpr bool allowed(DriveState from, DriveState to) noexcept {
+    using S = DriveState;
+    if (to == S::fault) return from != S::fault;
+    switch (from) {
+      case S::calibrating:
+        return to == S::idle;
+      case S::idle:
+        return to == S::magnetizing;
+      case S::magnetizing:
+        return to == S::running || to == S::idle;
+      case S::running:
+        return to == S::stopping;
+      case S::stopping:
+        return to == S::idle;
+      case S::fault:
+        return to == S::idle;
+    }
+    return false;
+  }
+
+  /// Transitions since start-up.
+  uint32_t count() const noexcept { return count_; }
+  /// How often a state was entered.
+  uint32_t entered(DriveState s) const noexcept { return entered_[static_cast<int>(s)]; }
+  /// Transition number n (0-based) if it is still in the log.
+  bool logged(uint32_t n, Transition& out) const noexcept {
+    if (n >= count_ || count_ - n > kLogDepth) return false;
+    out = log_[n % kLogDepth];
+    return true;
+  }
+
+ private:
+  DriveState state_ = DriveState::calibrating;
+  uint32_t count_ = 0;
+  std::array<uint32_t, kDriveStateCount> entered_{};
+  std::array<Transition, kLogDepth> log_{};
+};
+
+}  // namespace imd::firmware

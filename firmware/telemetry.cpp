@@ -1,0 +1,97 @@
+#include "firmware/telemetry.hpp"
+
+#include <algorithm>
+
+#include "firmware/protocol/frame_codec.hpp"
+
+namespace imd::firmware {
+
+using protocol::encode_frame;
+using protocol::MessageId;
+
+Telemetry::Telemetry(uint8_t node_id, uint32_t period_ns, int rate_Hz) noexcept
+    : node_id_(node_id),
+      period_ns_(period_ns),
+      ticks_per_10Hz_(std::max<uint64_t>(1, 100'000'000ull / period_ns)) {
+  if (!set_rate_Hz(rate_Hz)) set_rate_Hz(100);
+}
+
+bool Telemetry::set_rate_Hz(int rate_Hz) noexcept {
+  if (rate_Hz < protocol::kFastTelemetryMinHz || rate_Hz > protocol::kFastTelemetryMaxHz) {
+    return false;
+  }
+  rate_Hz_ = rate_Hz;
+  // Nearest whole number of ticks; at 10 kHz every rate from 10 to 1000 Hz is within 5 %.
+  const uint64_t ticks = (1'000'000'000ull / uint64_t(rate_Hz) + period_ns_ / 2) / period_ns_;
+  fast_period_ticks_ = std::max<uint64_t>(1, ticks);
+  return true;
+}
+
+uint32_t Telemetry::time_ms(uint64_t tick) const noexcept {
+  return static_cast<uint32_t>(tick * period_ns_ / 1'000'000ull);
+}
+
+void Telemetry::send(hal::CanBus& can, const hal::CanFrame& frame) noexcept {
+  if (!can.try_send(frame)) ++dropped_;
+}
+
+void Telemetry::publish(uint64_t k, hal::CanBus& can, const TickRecord& r,
+                        const DriveStatus& status, const StateMachine& machine,
+                        const ExecutionStats& execution, uint32_t budget_ns) noexcept {
+  Transition t;
+  while (transitions_sent_ < machine.count()) {
+    if (machine.logged(transitions_sent_, t)) {
+      hal::CanFrame frame =
+          encode_frame(node_id_, MessageId::state_change,
+                       {float(t.from), float(t.to), float(t.reason),
+                        float((transitions_sent_ + 1) & 0xFF)});
+      // Whole milliseconds exceed a float's 24-bit mantissa after 4.6 h: set the raw bits.
+      protocol::set_raw(frame.data, protocol::kStateChangeSignals[4], time_ms(t.tick));
+      send(can, frame);
+    }
+    ++transitions_sent_;  // a transition that fell out of the log is skipped
+  }
+  if (k % ticks_per_10Hz_ == 0) {
+    send(can, encode_frame(node_id_, MessageId::heartbeat,
+                           {float(status.state), float(status.fault_bits),
+                            float(status.first_fault), float(heartbeat_count_++),
+                            float(status.command_counter), float(status.controller),
+                            status.can_bus_off ? 1.0f : 0.0f,
+                            float(status.rejected_commands & 0xFF),
+                            float(machine.count() & 0xFF)}));
+  }
+  if (k % ticks_per_10Hz_ == ticks_per_10Hz_ / 2) {  // between heartbeats, to spread the load
+    send(can, encode_frame(node_id_, MessageId::timing,
+                           {float(execution.mean_ns() * 1e-3), float(execution.max_ns) * 1e-3f,
+                            float(std::min<uint64_t>(execution.overruns, 0xFFFF)),
+                            float(budget_ns) * 1e-3f}));
+  }
+  if (k % fast_period_ticks_ == 0) {
+    send(can, encode_frame(node_id_, MessageId::telemetry_speed_flux,
+                           {float(r.omega_est_rad_s), float(r.omega_ref_rad_s),
+                            float(r.flux2_est_Wb2), float(r.flux2_ref_Wb2)}));
+    send(can, encode_frame(node_id_, MessageId::telemetry_current,
+                           {float(r.i_A_A), float(r.i_B_A), float(r.load_est_Nm),
+                            float(r.v_bus_V)}));
+    send(can, encode_frame(node_id_, MessageId::telemetry_voltage,
+                           {float(r.u_alpha_V), float(r.u_beta_V), float(sample_count_++)}));
+  }
+}
+
+void Telemetry::report_fault(hal::CanBus& can, const DriveStatus& status) noexcept {
+  hal::CanFrame frame = encode_frame(node_id_, MessageId::fault_report,
+                                     {float(status.first_fault), float(status.fault_bits), 0.0f,
+                                      float(status.fault_detail)});
+  protocol::set_raw(frame.data, protocol::kFaultReportSignals[2],
+                    time_ms(status.first_fault_tick));
+  send(can, frame);
+}
+
+void Telemetry::acknowledge(hal::CanBus& can, const protocol::Decoded& decoded,
+                            uint32_t rejected_total) noexcept {
+  send(can, encode_frame(node_id_, MessageId::command_ack,
+                         {float(decoded.message_id), float(decoded.counter),
+                          float(decoded.result), float(std::min<uint32_t>(rejected_total, 0xFFFF))}));
+}
+
+}  // namespace imd::firmware

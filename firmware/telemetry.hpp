@@ -1,0 +1,67 @@
+#pragma once
+/// What the drive sends on CAN, and when (docs/can/protocol.md): the heartbeat and the timing
+/// frame at 10 Hz, fast telemetry at a configurable 10..1000 Hz (three frames per sample, the
+/// voltage frame last), and event frames for state changes, faults and command results.
+/// Frames go to the HAL's non-blocking transmit queue; a full queue drops the frame and counts
+/// it. Tick context, no heap.
+#include <cstdint>
+
+#include "firmware/drive_state.hpp"
+#include "firmware/execution_stats.hpp"
+#include "firmware/protocol/commands.hpp"
+#include "firmware/state_machine.hpp"
+#include "firmware/tick_record.hpp"
+#include "hal/can_bus.hpp"
+
+namespace imd::firmware {
+
+/// The drive's status as the heartbeat and the fault report carry it.
+struct DriveStatus {
+  DriveState state = DriveState::calibrating;
+  uint16_t fault_bits = 0;
+  FaultCode first_fault = FaultCode::none;
+  uint64_t first_fault_tick = 0;
+  uint8_t fault_detail = 0;
+  uint8_t controller = 0;  ///< 0 dsmc, 1 iol
+  uint8_t command_counter = 0;
+  uint32_t rejected_commands = 0;
+  bool can_bus_off = false;
+};
+
+class Telemetry {
+ public:
+  /// `period_ns`: the control period.
+  Telemetry(uint8_t node_id, uint32_t period_ns, int rate_Hz) noexcept;
+
+  /// Sets the fast-telemetry rate; false (unchanged) outside 10..1000 Hz.
+  bool set_rate_Hz(int rate_Hz) noexcept;
+  int rate_Hz() const noexcept { return rate_Hz_; }
+
+  /// The cyclic frames due at tick k, and a state_change frame for each new transition.
+  void publish(uint64_t k, hal::CanBus& can, const TickRecord& record, const DriveStatus& status,
+               const StateMachine& machine, const ExecutionStats& execution,
+               uint32_t budget_ns) noexcept;
+  /// The fault_report frame, sent when a fault latches.
+  void report_fault(hal::CanBus& can, const DriveStatus& status) noexcept;
+  /// The command_ack frame for a command frame addressed to this node.
+  void acknowledge(hal::CanBus& can, const protocol::Decoded& decoded,
+                   uint32_t rejected_total) noexcept;
+
+  uint32_t dropped_frames() const noexcept { return dropped_; }
+
+ private:
+  void send(hal::CanBus& can, const hal::CanFrame& frame) noexcept;
+  uint32_t time_ms(uint64_t tick) const noexcept;
+
+  uint8_t node_id_;
+  uint32_t period_ns_;
+  uint64_t ticks_per_10Hz_;
+  uint64_t fast_period_ticks_ = 1;
+  int rate_Hz_ = 100;
+  uint8_t heartbeat_count_ = 0;
+  uint8_t sample_count_ = 0;
+  uint32_t transitions_sent_ = 0;
+  uint32_t dropped_ = 0;
+};
+
+}  // namespace imd::firmware
