@@ -13,15 +13,28 @@ for option in "$@"; do
   esac
 done
 
+# The third-party DBC check (tools/dbc_check) runs on Node.js: Debian's nodejs and npm, unless a
+# node and an npm are already on the PATH.
+if ! command -v node >/dev/null 2>&1 || ! command -v npm >/dev/null 2>&1; then
+  packages="$packages nodejs npm"
+fi
+
 missing=""
 for package in $packages; do
   if ! dpkg-query -W -f='${Status}' "$package" 2>/dev/null | grep -q "install ok installed"; then
     missing="$missing $package"
   fi
 done
-[ -z "$missing" ] && exit 0
+if [ -n "$missing" ]; then
+  echo "install_deps: installing$missing"
+  if [ "$(id -u)" -eq 0 ]; then sudo=""; else sudo="sudo"; fi
+  $sudo apt-get update -qq
+  $sudo env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends $missing
+fi
 
-echo "install_deps: installing$missing"
-if [ "$(id -u)" -eq 0 ]; then sudo=""; else sudo="sudo"; fi
-$sudo apt-get update -qq
-$sudo env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends $missing
+# ...and on the npm packages its package-lock.json pins.
+dbc_check="$(cd "$(dirname "$0")" && pwd)/dbc_check"
+if [ ! -f "$dbc_check/node_modules/candied/package.json" ]; then
+  echo "install_deps: npm ci in $dbc_check"
+  npm ci --prefix "$dbc_check" --no-audit --no-fund
+fi

@@ -103,7 +103,7 @@ inline constexpr ValueName kTransitionReasonValues[] = {
 };
 
 // --- the E2E header every command starts with
-inline constexpr Signal kE2eCrc{"crc", 0, 8, false, 1, 1, 0.0f, "", "CRC-8 SAE J1850 over id and bytes 1.."};
+inline constexpr Signal kE2eCrc{"crc", 0, 8, false, 1, 1, 0.0f, "", "CRC-8 SAE J1850 over the CAN id and bytes 1 to DLC-1"};
 inline constexpr Signal kE2eCounter{"counter", 8, 4, false, 1, 1, 0.0f, "",
                                     "alive counter, +1 (mod 16) per command frame"};
 

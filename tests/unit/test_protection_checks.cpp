@@ -1,0 +1,194 @@
+// The protection detectors on their own: the state machine's graph, the encoder plausibility
+// model, the stuck-ADC and phase-loss checks.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+
+#include "firmware/protection/adc_stuck_check.hpp"
+#include "firmware/protection/encoder_check.hpp"
+#include "firmware/protection/phase_loss_check.hpp"
+#include "firmware/state_machine.hpp"
+
+namespace imd::firmware {
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+
+TEST(StateMachine, FollowsTheGraphAndLogsEveryTransition) {
+  StateMachine m;
+  EXPECT_FALSE(m.go(DriveState::running, TransitionReason::enable, 1));  // not from calibrating
+  EXPECT_EQ(m.state(), DriveState::calibrating);
+  EXPECT_TRUE(m.go(DriveState::idle, TransitionReason::calibrated, 2));
+  EXPECT_FALSE(m.go(DriveState::running, TransitionReason::enable, 3));  // magnetize first
+  EXPECT_TRUE(m.go(DriveState::magnetizing, TransitionReason::enable, 4));
+  EXPECT_TRUE(m.go(DriveState::running, TransitionReason::magnetized, 5));
+  EXPECT_FALSE(m.go(DriveState::idle, TransitionReason::disable, 6));  // stop first
+  EXPECT_TRUE(m.go(DriveState::fault, TransitionReason::fault, 7));
+  EXPECT_FALSE(m.go(DriveState::fault, TransitionReason::fault, 8));        // already latched
+  EXPECT_FALSE(m.go(DriveState::magnetizing, TransitionReason::enable, 9));  // clear first
+  EXPECT_TRUE(m.go(DriveState::idle, TransitionReason::clear_faults, 10));
+  EXPECT_EQ(m.count(), 5u);
+  EXPECT_EQ(m.entered(DriveState::idle), 2u);
+  Transition t;
+  ASSERT_TRUE(m.logged(3, t));
+  EXPECT_EQ(t.tick, 7u);
+  EXPECT_EQ(t.from, DriveState::running);
+  EXPECT_EQ(t.to, DriveState::fault);
+  EXPECT_FALSE(m.logged(5, t));
+}
+
+TEST(StateMachine, KeepsTheLastTransitionsWhenTheLogWraps) {
+  StateMachine m;
+  m.go(DriveState::idle, TransitionReason::calibrated, 0);
+  for (uint64_t k = 1; k <= 40; k += 2) {
+    m.go(DriveState::magnetizing, TransitionReason::enable, k);
+    m.go(DriveState::idle, TransitionReason::disable, k + 1);
+  }
+  Transition t;
+  EXPECT_FALSE(m.logged(0, t));
+  ASSERT_TRUE(m.logged(m.count() - 1, t));
+  EXPECT_EQ(t.tick, 40u);
+  EXPECT_EQ(t.reason, TransitionReason::disable);
+}
+
+/// The paper-000 motor's inertia and an 8192-count encoder at 10 kHz.
+EncoderCheck<double>::Config encoder_config() {
+  return {8192.0, 1e-4, 0.01, 0.0, 6.0, 0.01, 400.0};
+}
+constexpr double kCountRad = 2 * kPi / 8192.0;
+
+TEST(EncoderCheck, AWorkingEncoderAtSpeedPasses) {
+  EncoderCheck<double> check(encoder_config());
+  // 3 rad/s: one count every 2.6 ticks; the counts arrive as the angle crosses each step.
+  double theta = 0.0;
+  long last = 0;
+  for (int k = 0; k < 20000; ++k) {
+    theta += 3.0 * 1e-4;
+    const long count = std::lround(std::floor(theta / kCountRad));
+    ASSERT_FALSE(check.failed(int32_t(count - last), 3.0, 0.5, 0.5)) << k;
+    last = count;
+  }
+}
+
+TEST(EncoderCheck, SilenceAtSpeedFailsWithinTheMissingCounts) {
+  EncoderCheck<double> check(encoder_config());
+  EXPECT_FALSE(check.failed(13, 100.0, 0.0, 0.0));  // 100 rad/s = 13 counts per tick
+  // Frozen: the model predicts 13 counts over the next period, more than the 6 allowed.
+  EXPECT_TRUE(check.failed(0, 100.0, 0.0, 0.0));
+}
+
+TEST(EncoderCheck, AcceleratingWithoutCountsFailsWithinTenMilliseconds) {
+  EncoderCheck<double> check(encoder_config());
+  // From rest with 1 N m more than the load on J = 0.01: 100 rad/s^2. Six counts
+  // (4.6e-3 rad) take sqrt(2 * 4.6e-3 / 100) = 9.6 ms.
+  int k = 0;
+  while (!check.failed(0, 0.0, 0.0, 1.0) && k < 1000) ++k;
+  EXPECT_LE(k, 100);
+  EXPECT_GE(k, 90);
+}
+
+TEST(EncoderCheck, AHeldRotorWithAnEstimationBiasPasses) {
+  // Standstill under load: no counts for 10 s, torque = load up to a 0.5 N m bias. Within one
+  // 10 ms window the bias moves the model by 0.5 * 0.01^2 / (2 * 0.01) = 2.5e-3 rad = 3.3
+  // counts < 6, and the window re-anchors to the (zero) estimated speed.
+  EncoderCheck<double> check(encoder_config());
+  for (int k = 0; k < 100000; ++k) ASSERT_FALSE(check.failed(0, 0.0, 1.0, 1.5)) << k;
+}
+
+TEST(EncoderCheck, ABrakedStopPasses) {
+  // 2 rad/s braked at 200 rad/s^2 (2 N m on J = 0.01): it stops after 1e-2 rad = 13 counts;
+  // the counts stop with it, and the model's braking predicts the stop.
+  EncoderCheck<double> check(encoder_config());
+  double omega = 2.0, theta = 0.0;
+  long last = 0;
+  for (int k = 0; k < 5000; ++k) {
+    const double torque = omega > 0 ? -2.0 : 0.0;
+    theta += omega * 1e-4;
+    omega = std::max(0.0, omega + torque / 0.01 * 1e-4);
+    const long count = std::lround(std::floor(theta / kCountRad));
+    ASSERT_FALSE(check.failed(int32_t(count - last), omega, 0.0, omega > 0 ? -2.0 : 0.0)) << k;
+    last = count;
+  }
+}
+
+TEST(EncoderCheck, AnImplausibleJumpFails) {
+  EncoderCheck<double> check(encoder_config());
+  // 1.5 x 400 rad/s over 1e-4 s is 0.06 rad = 78.2 counts; with 2 counts of margin for the
+  // latching instant, 81 is the largest plausible step.
+  EXPECT_EQ(check.max_jump_counts(), 81);
+  EXPECT_FALSE(check.failed(81, 390.0, 0.0, 0.0));
+  EXPECT_TRUE(check.failed(-82, 390.0, 0.0, 0.0));
+}
+
+TEST(AdcStuckCheck, RepeatedCodesWithAMovingVoltageAreStuck) {
+  // 1 A per code, sigma_H = 0.0259 H (paper motor), 1e-4 s: 1 V of change moves 3.861 mA, so
+  // 4 codes need 1036 V of accumulated change.
+  AdcStuckCheck<double> check(20, 1e-4, 0.0259, 1.0);
+  const std::array<uint16_t, 3> codes{2048, 2000, 2100};
+  int k = 0;
+  double angle = 0.0;
+  bool stuck = false;
+  for (; k < 200 && !stuck; ++k, angle += 0.05) {
+    stuck = check.stuck(codes, {150.0 * std::cos(angle), 150.0 * std::sin(angle)});
+  }
+  EXPECT_TRUE(stuck);
+  // 150 V turning by 0.05 rad per tick changes by 2 * 150 * sin(0.025) = 7.4996 V per tick:
+  // 1036 V take 139 ticks after the first sample, so the 140th call finds it stuck.
+  EXPECT_EQ(k, 140);
+}
+
+TEST(AdcStuckCheck, AQuietConverterAtAConstantVoltageIsNot) {
+  AdcStuckCheck<double> check(20, 1e-4, 0.0259, 0.005);
+  const std::array<uint16_t, 3> codes{2048, 2000, 2100};
+  for (int k = 0; k < 10000; ++k) ASSERT_FALSE(check.stuck(codes, {40.0, 0.0}));
+}
+
+TEST(AdcStuckCheck, ChangingCodesAreNotStuck) {
+  AdcStuckCheck<double> check(20, 1e-4, 0.0259, 0.005);
+  for (int k = 0; k < 10000; ++k) {
+    const std::array<uint16_t, 3> codes{uint16_t(2048 + k % 2), 2000, 2100};
+    ASSERT_FALSE(check.stuck(codes, {150.0 * std::cos(k), 150.0 * std::sin(k)}));
+  }
+}
+
+/// Phase currents of amplitude 5 A at the flux angle plus a load angle.
+void phase_currents(double angle, double (&i)[3]) {
+  for (int p = 0; p < 3; ++p) i[p] = 5.0 * std::cos(angle + 0.6 - 2 * kPi * p / 3);
+}
+
+TEST(PhaseLossCheck, BalancedCurrentsPass) {
+  PhaseLossCheck<double> check(0.3, 0.5, 10000);
+  double i[3];
+  for (int k = 0; k < 100000; ++k) {
+    const double angle = 0.01 * k;
+    phase_currents(angle, i);
+    ASSERT_EQ(check.lost_phase(i, angle), -1) << k;
+  }
+}
+
+TEST(PhaseLossCheck, AnOpenPhaseIsFoundWithinTwoRevolutions) {
+  PhaseLossCheck<double> check(0.3, 0.5, 10000);
+  double i[3];
+  int lost = -1, k = 0;
+  for (; k < 2000 && lost < 0; ++k) {
+    const double angle = 0.01 * k;
+    phase_currents(angle, i);
+    i[1] = 0.0;           // phase b open...
+    i[2] = -i[0];         // ...so c carries a's current back
+    lost = check.lost_phase(i, angle);
+  }
+  EXPECT_EQ(lost, 1);
+  EXPECT_LE(k, 630);  // one revolution: 629 steps of 0.01 rad after the first sample
+}
+
+TEST(PhaseLossCheck, ADirectCurrentIsNotJudged) {
+  // Magnetizing at rest: phase a carries 5 A, b and c -2.5 A; with the current along b's
+  // normal, b carries nothing, legitimately.
+  PhaseLossCheck<double> check(0.3, 0.5, 10000);
+  double i[3] = {4.33, 0.0, -4.33};
+  for (int k = 0; k < 100000; ++k) ASSERT_EQ(check.lost_phase(i, 0.3), -1);
+}
+
+}  // namespace
+}  // namespace imd::firmware

@@ -1,0 +1,82 @@
+// dbc_gen: writes the DBC file and the Markdown reference of the drive's CAN protocol for one
+// node, from the message table in firmware/protocol/messages.hpp.
+#include <CLI/CLI.hpp>
+#include <cerrno>
+#include <cstring>
+#include <fstream>
+#include <iostream>
+#include <string>
+
+#include "firmware/protocol/messages.hpp"
+#include "writers.hpp"
+
+namespace {
+
+constexpr int kExitBadInput = 2;
+
+/// A node id must be an integer in 0..kMaxNodeId.
+const CLI::Validator kNodeId(
+    [](std::string& text) -> std::string {
+      const int max_id = imd::firmware::protocol::kMaxNodeId;
+      std::size_t end = 0;
+      int value = -1;
+      try {
+        value = std::stoi(text, &end);
+      } catch (const std::exception&) {
+        end = 0;
+      }
+      if (end == 0 || end != text.size() || value < 0 || value > max_id) {
+        return "must be a node id in 0.." + std::to_string(max_id) + ", got " + text;
+      }
+      return {};
+    },
+    "0..63");
+
+/// Writes `text` to `path`; on failure returns why, naming the flag and the path.
+std::string write_file(const std::string& flag, const std::string& path, const std::string& text) {
+  errno = 0;
+  std::ofstream file(path, std::ios::binary | std::ios::trunc);
+  if (file) file << text;
+  if (file) file.close();
+  if (file) return {};
+  const std::string why = errno != 0 ? std::strerror(errno) : "write error";
+  return flag + " " + path + ": cannot write the file (" + why + ")";
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"Writes the DBC file (and a Markdown reference) of the drive's CAN protocol."};
+  int node_id = 1;
+  std::string dbc_path, markdown_path;
+  app.add_option("--node", node_id, "CAN node id of the drive")
+      ->check(kNodeId)
+      ->capture_default_str();
+  app.add_option("--output", dbc_path, "Write the DBC file here (default: standard output)")
+      ->type_name("PATH");
+  app.add_option("--markdown", markdown_path, "Also write the Markdown protocol reference here")
+      ->type_name("PATH");
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& error) {
+    const int code = app.exit(error);
+    return code == 0 ? 0 : kExitBadInput;
+  }
+
+  const auto node = static_cast<uint8_t>(node_id);
+  const std::string dbc = imd::tools::dbc::dbc_text(node);
+  std::string error;
+  if (dbc_path.empty()) {
+    std::cout << dbc;
+  } else {
+    error = write_file("--output", dbc_path, dbc);
+  }
+  if (error.empty() && !markdown_path.empty()) {
+    error = write_file("--markdown", markdown_path, imd::tools::dbc::markdown_text(node));
+  }
+  if (!error.empty()) {
+    std::cerr << "dbc_gen: " << error << '\n';
+    return kExitBadInput;
+  }
+  return 0;
+}
