@@ -1,0 +1,229 @@
+// The drive commanded over CAN on the simulated board: enable, run, disable with a ramp to a
+// stop, emergency stop and clear, the watchdog, refusals by state, and the telemetry cadence.
+#include <gtest/gtest.h>
+
+#include <vector>
+
+#include "firmware/drive.hpp"
+#include "firmware/protocol/frame_codec.hpp"
+#include "hal_sim/sim_board.hpp"
+#include "test_motors.hpp"
+
+namespace imd::firmware {
+namespace {
+
+using protocol::Command;
+using protocol::CommandKind;
+using protocol::CommandResult;
+using protocol::MessageId;
+
+struct NoProfile final : ReferenceSource {
+  Reference at_tick(uint64_t) const noexcept override { return {}; }
+};
+
+/// The paper-000 motor on a realistic board, commanded over CAN as node 1.
+struct CanRig {
+  sim::SimBoard board;
+  NoProfile unused;
+  Drive<double> drive;
+  protocol::CommandEncoder host{1};
+  std::vector<hal::CanFrame> sent;
+
+  static DriveConfig config() {
+    DriveConfig c;
+    c.commands_over_can = true;
+    c.i_max_A = 6.0;
+    c.protection.overcurrent_A = 9.0;
+    c.protection.tick_budget_ns = 0;  // wall-clock time on a shared host is not the MCU's
+    c.protection.command_timeout_s = 0.1;
+    c.speed_reaching_pole = c.flux_reaching_pole = 0.98;
+    c.max_accel_rad_s2 = 500.0;
+    c.flux2_ref_Wb2 = 0.2;
+    return c;
+  }
+  static sim::SimBoardConfig board_config() {
+    sim::SimBoardConfig b;
+    b.adc.noise_A = 0.01;
+    return b;
+  }
+  explicit CanRig(const DriveConfig& c = config())
+      : board(test::test_motors()[0].parameters, board_config()),
+        drive(test::test_motors()[0].parameters, c,
+              {board.pwm(), board.encoder(), board.adc(), board.timer(), nullptr, nullptr,
+               &board.can()},
+              unused) {
+    board.timer().start(drive);
+  }
+  void send(const Command& c) { board.can_side().inject(host.encode(c)); }
+  void run(int ticks) {
+    for (int k = 0; k < ticks; ++k) {
+      board.run_tick();
+      for (const hal::CanFrame& f : board.can_side().take_sent()) sent.push_back(f);
+    }
+  }
+  /// The results of the command_ack frames sent so far.
+  std::vector<CommandResult> acks() const {
+    std::vector<CommandResult> r;
+    for (const hal::CanFrame& f : sent) {
+      if (f.id == protocol::can_id(1, MessageId::command_ack)) {
+        r.push_back(CommandResult(protocol::get_raw(f.data, protocol::kCommandAckSignals[2])));
+      }
+    }
+    return r;
+  }
+  int count(MessageId id) const {
+    int n = 0;
+    for (const hal::CanFrame& f : sent) n += f.id == protocol::can_id(1, id) ? 1 : 0;
+    return n;
+  }
+};
+
+TEST(DriveCommands, EnableRunsAndDisableRampsToAStopBeforeThePwmGoesOff) {
+  CanRig rig;
+  rig.run(300);  // offset calibration
+  ASSERT_EQ(rig.drive.state(), DriveState::idle);
+  EXPECT_FALSE(rig.board.pwm().enabled());
+  rig.send({CommandKind::set_speed, 30.0f});
+  rig.send({CommandKind::enable});
+  int k = 0;
+  for (; k < 20000 && rig.drive.state() != DriveState::running; ++k) {
+    rig.run(1);
+    if (k % 500 == 0) rig.send({CommandKind::set_speed, 30.0f});  // keep the watchdog fed
+  }
+  ASSERT_EQ(rig.drive.state(), DriveState::running);
+  for (int n = 0; n < 20; ++n) {  // 1 s at 30 rad/s
+    rig.send({CommandKind::set_speed, 30.0f});
+    rig.run(500);
+  }
+  EXPECT_NEAR(rig.board.plant().state().omega_mech_rad_s, 30.0, 0.5);
+  rig.send({CommandKind::disable});
+  rig.run(1);
+  EXPECT_EQ(rig.drive.state(), DriveState::stopping);
+  EXPECT_TRUE(rig.board.pwm().enabled());  // still driving: the stop is controlled
+  int stop_ticks = 0;
+  while (rig.drive.state() == DriveState::stopping && stop_ticks < 20000) {
+    rig.run(1);
+    ++stop_ticks;
+  }
+  EXPECT_EQ(rig.drive.state(), DriveState::idle);
+  EXPECT_FALSE(rig.board.pwm().enabled());
+  // 30 rad/s at the 200 rad/s^2 stop ramp take 0.15 s, then the speed settles below 1 rad/s.
+  EXPECT_GE(stop_ticks, 1500);
+  EXPECT_LE(stop_ticks, 2500);
+  EXPECT_LT(std::abs(rig.board.plant().state().omega_mech_rad_s), 1.5);
+  // calibrated, enable, magnetized, disable, stopped: each logged and reported once.
+  EXPECT_EQ(rig.drive.state_machine().count(), 5u);
+  EXPECT_EQ(rig.count(MessageId::state_change), 5);
+  for (const CommandResult r : rig.acks()) EXPECT_EQ(r, CommandResult::accepted);
+}
+
+TEST(DriveCommands, EmergencyStopLatchesUntilCleared) {
+  CanRig rig;
+  rig.run(300);
+  rig.send({CommandKind::enable});
+  rig.run(100);
+  ASSERT_TRUE(rig.board.pwm().enabled());
+  rig.send({CommandKind::emergency_stop});
+  rig.run(1);
+  EXPECT_FALSE(rig.board.pwm().enabled());  // in the tick that received it
+  EXPECT_EQ(rig.drive.state(), DriveState::fault);
+  EXPECT_EQ(rig.drive.fault(), FaultCode::emergency_stop);
+  EXPECT_EQ(rig.count(MessageId::fault_report), 1);
+  rig.send({CommandKind::enable});  // refused while faulted
+  rig.run(10);
+  EXPECT_EQ(rig.drive.state(), DriveState::fault);
+  EXPECT_EQ(rig.acks().back(), CommandResult::not_allowed);
+  rig.send({CommandKind::clear_faults});
+  rig.run(1);
+  EXPECT_EQ(rig.drive.state(), DriveState::idle);
+  EXPECT_EQ(rig.drive.fault(), FaultCode::none);
+  EXPECT_EQ(rig.drive.status().fault_bits, 0);
+}
+
+TEST(DriveCommands, TheWatchdogTripsWhenCommandsStop) {
+  CanRig rig;
+  rig.run(300);
+  rig.send({CommandKind::enable});
+  rig.run(1);
+  const uint64_t last_command_tick = rig.board.timer().tick_count() - 1;
+  int k = 0;
+  while (rig.drive.state() != DriveState::fault && k < 5000) {
+    rig.run(1);
+    ++k;
+  }
+  EXPECT_EQ(rig.drive.fault(), FaultCode::command_timeout);
+  // Timeout 0.1 s = 1000 ticks: it trips on the first tick past it.
+  EXPECT_EQ(rig.drive.status().first_fault_tick - last_command_tick, 1001u);
+  EXPECT_FALSE(rig.board.pwm().enabled());
+}
+
+TEST(DriveCommands, RefusesWhatTheStateDoesNotAllow) {
+  CanRig rig;
+  rig.run(300);
+  rig.send({CommandKind::enable});
+  rig.run(10);
+  rig.send({CommandKind::select_controller, 1.0f});  // only while idle
+  rig.run(1);
+  EXPECT_EQ(rig.acks().back(), CommandResult::not_allowed);
+  EXPECT_EQ(rig.drive.status().controller, 0);
+  EXPECT_EQ(rig.drive.commands().rejected(CommandResult::not_allowed), 1u);
+  rig.send({CommandKind::disable});  // magnetizing: straight to idle
+  rig.run(1);
+  EXPECT_EQ(rig.drive.state(), DriveState::idle);
+  // The current-fed law has no speed loop in this configuration: it cannot follow set_speed.
+  rig.send({CommandKind::select_controller, 1.0f});
+  rig.run(1);
+  EXPECT_EQ(rig.acks().back(), CommandResult::not_allowed);
+  DriveConfig with_loop = CanRig::config();
+  with_loop.outer_speed_loop = true;
+  CanRig rig2(with_loop);
+  rig2.run(300);
+  rig2.send({CommandKind::select_controller, 1.0f});
+  rig2.run(1);
+  EXPECT_EQ(rig2.acks().back(), CommandResult::accepted);
+  EXPECT_EQ(rig2.drive.status().controller, 1);
+}
+
+TEST(DriveCommands, ProfileDrivenReferencesRefuseSetSpeed) {
+  DriveConfig c = CanRig::config();
+  c.commands_over_can = false;
+  CanRig rig(c);
+  rig.run(300);
+  rig.send({CommandKind::set_speed, 10.0f});
+  rig.send({CommandKind::set_flux, 0.1f});
+  rig.run(1);
+  ASSERT_EQ(rig.acks().size(), 2u);
+  EXPECT_EQ(rig.acks()[0], CommandResult::not_allowed);
+  EXPECT_EQ(rig.acks()[1], CommandResult::not_allowed);
+}
+
+TEST(DriveCommands, RejectedFramesAreAcknowledgedAndChangeNothing) {
+  CanRig rig;
+  rig.run(300);
+  hal::CanFrame bad = rig.host.encode({CommandKind::enable});
+  bad.data[0] ^= 0xFF;
+  rig.board.can_side().inject(bad);
+  rig.run(10);
+  EXPECT_EQ(rig.drive.state(), DriveState::idle);
+  ASSERT_EQ(rig.acks().size(), 1u);
+  EXPECT_EQ(rig.acks()[0], CommandResult::bad_crc);
+  EXPECT_EQ(rig.drive.status().rejected_commands, 1u);
+}
+
+TEST(DriveCommands, TelemetryRunsAtItsRates) {
+  CanRig rig;
+  rig.run(10000);  // 1 s
+  EXPECT_EQ(rig.count(MessageId::heartbeat), 10);
+  EXPECT_EQ(rig.count(MessageId::timing), 10);
+  EXPECT_EQ(rig.count(MessageId::telemetry_speed_flux), 100);  // the 100 Hz default
+  rig.send({CommandKind::set_telemetry_rate, 1000.0f});
+  rig.sent.clear();
+  rig.run(10000);
+  EXPECT_EQ(rig.count(MessageId::telemetry_speed_flux), 1000);
+  EXPECT_EQ(rig.count(MessageId::telemetry_current), 1000);
+  EXPECT_EQ(rig.count(MessageId::telemetry_voltage), 1000);
+  EXPECT_EQ(rig.drive.telemetry().dropped_frames(), 0u);
+}
+
+}  // namespace
+}  // namespace imd::firmware
