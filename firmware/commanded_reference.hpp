@@ -12,7 +12,9 @@ class CommandedReference final : public ReferenceSource {
     reference_.stator_flux2_Wb2 = stator_flux2_Wb2;
   }
   Reference at_tick(uint64_t) const noexcept override { return reference_; }
-  void set_speed(double omega_mech_rad_s) noexcept { reference_.omega_mech_rad_s = omega_mech_rad_s; }
+  void set_speed(double omega_mech_rad_s) noexcept {
+    reference_.omega_mech_rad_s = omega_mech_rad_s;
+  }
   void set_flux2(double flux2_Wb2) noexcept { reference_.flux2_Wb2 = flux2_Wb2; }
   void set_stator_flux2(double flux2_Wb2) noexcept { reference_.stator_flux2_Wb2 = flux2_Wb2; }
 

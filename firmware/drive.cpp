@@ -266,8 +266,8 @@ void Drive<T>::protect(uint64_t k, const Estimate& e, const hal::AdcSample& samp
   if (oracle_ == nullptr && adc_stuck_check_.stuck(sample.phase_code, u_written_V_)) {
     trip(FaultCode::adc_stuck, k);
   }
-  const T flux_angle_rad = pole_pairs_ * e.x.theta_mech_rad +
-                           std::atan2(e.x.flux_r_AB_Wb.y(), e.x.flux_r_AB_Wb.x());
+  const T flux_angle_rad =
+      pole_pairs_ * e.x.theta_mech_rad + std::atan2(e.x.flux_r_AB_Wb.y(), e.x.flux_r_AB_Wb.x());
   const int lost = phase_loss_check_.lost_phase(phase_current_A_, flux_angle_rad);
   if (lost >= 0) trip(FaultCode::phase_loss, k, uint8_t(lost));
   const DriveState s = machine_.state();
@@ -323,7 +323,8 @@ control::Vec2<T> Drive<T>::control(uint64_t k, const Estimate& e, T v_bus_V) noe
     Reference boundary_ref = references_.at_tick(k + uint64_t(iol_stage_.ticks_per_period()));
     boundary_ref.omega_mech_rad_s = ref.omega_mech_rad_s;  // through the speed ramp
     if (stopping) boundary_ref.torque_Nm = 0.0;
-    const IolTickResult<T> r = iol_stage_.tick(e.x.flux_r_AB_Wb, e.x.omega_mech_rad_s, boundary_ref);
+    const IolTickResult<T> r =
+        iol_stage_.tick(e.x.flux_r_AB_Wb, e.x.omega_mech_rad_s, boundary_ref);
     if (r.status != control::IolStatus::ok) trip(FaultCode::singular_control, k);
     i_command = r.i_cmd_AB_A;
     record_.i_held_A_A = double(r.i_held_AB_A.x());

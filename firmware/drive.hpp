@@ -138,8 +138,8 @@ class Drive final : public hal::TickHandler {
   uint64_t magnetizing_start_tick_ = 0, magnetizing_timeout_ticks_ = 0;
   uint64_t last_command_tick_ = 0, command_timeout_ticks_ = 0;
   uint64_t stop_start_tick_ = 0, stop_timeout_ticks_ = 0;
-  int32_t encoder_delta_counts_ = 0;   ///< counts over the last period
-  Vec2 u_written_V_ = Vec2::Zero();     ///< last stator voltage command (alpha-beta)
+  int32_t encoder_delta_counts_ = 0;  ///< counts over the last period
+  Vec2 u_written_V_ = Vec2::Zero();   ///< last stator voltage command (alpha-beta)
   int calibration_count_ = 0;
   int64_t calibration_sum_[3] = {0, 0, 0};
   T offset_code_[3] = {T(0), T(0), T(0)};
@@ -149,7 +149,7 @@ class Drive final : public hal::TickHandler {
   Vec2 v_in_flight_V_ = Vec2::Zero();  ///< written last tick, acts over this period (latency 1)
   T peak_phase_current_A_ = T(0);      ///< largest phase current of this tick
   T phase_current_A_[3] = {T(0), T(0), T(0)};
-  bool adc_saturated_ = false;         ///< a phase-current code on a rail this tick
+  bool adc_saturated_ = false;  ///< a phase-current code on a rail this tick
   TickRecord record_;
   ExecutionStats execution_;
 };

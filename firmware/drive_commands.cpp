@@ -89,8 +89,8 @@ protocol::CommandResult Drive<T>::apply(const protocol::Command& c, uint64_t k) 
     case CommandKind::select_controller: {
       const ControllerKind wanted = c.value == 1.0f ? ControllerKind::iol : ControllerKind::dsmc;
       // Only at rest; the current-fed law follows a speed reference only with its speed loop.
-      const bool speed_capable = wanted == ControllerKind::dsmc || config_.outer_speed_loop ||
-                                 !config_.commands_over_can;
+      const bool speed_capable =
+          wanted == ControllerKind::dsmc || config_.outer_speed_loop || !config_.commands_over_can;
       if (s != DriveState::idle || !speed_capable) return CommandResult::not_allowed;
       controller_ = wanted;
       status_.controller = wanted == ControllerKind::iol ? 1 : 0;
@@ -105,10 +105,10 @@ protocol::CommandResult Drive<T>::apply(const protocol::Command& c, uint64_t k) 
 }
 
 // The class is instantiated in drive.cpp; these members are defined here.
-#define IMD_INSTANTIATE_COMMANDS(T)                                                           \
-  template void Drive<T>::receive_commands(uint64_t) noexcept;                                \
-  template void Drive<T>::enable(uint64_t) noexcept;                                          \
-  template void Drive<T>::clear_faults(uint64_t) noexcept;                                    \
+#define IMD_INSTANTIATE_COMMANDS(T)                            \
+  template void Drive<T>::receive_commands(uint64_t) noexcept; \
+  template void Drive<T>::enable(uint64_t) noexcept;           \
+  template void Drive<T>::clear_faults(uint64_t) noexcept;     \
   template protocol::CommandResult Drive<T>::apply(const protocol::Command&, uint64_t) noexcept;
 IMD_INSTANTIATE_COMMANDS(float)
 IMD_INSTANTIATE_COMMANDS(double)

@@ -41,10 +41,9 @@ void Telemetry::publish(uint64_t k, hal::CanBus& can, const TickRecord& r,
   Transition t;
   while (transitions_sent_ < machine.count()) {
     if (machine.logged(transitions_sent_, t)) {
-      hal::CanFrame frame =
-          encode_frame(node_id_, MessageId::state_change,
-                       {float(t.from), float(t.to), float(t.reason),
-                        float((transitions_sent_ + 1) & 0xFF)});
+      hal::CanFrame frame = encode_frame(
+          node_id_, MessageId::state_change,
+          {float(t.from), float(t.to), float(t.reason), float((transitions_sent_ + 1) & 0xFF)});
       // Whole milliseconds exceed a float's 24-bit mantissa after 4.6 h: set the raw bits.
       protocol::set_raw(frame.data, protocol::kStateChangeSignals[4], time_ms(t.tick));
       send(can, frame);
@@ -52,13 +51,12 @@ void Telemetry::publish(uint64_t k, hal::CanBus& can, const TickRecord& r,
     ++transitions_sent_;  // a transition that fell out of the log is skipped
   }
   if (k % ticks_per_10Hz_ == 0) {
-    send(can, encode_frame(node_id_, MessageId::heartbeat,
-                           {float(status.state), float(status.fault_bits),
-                            float(status.first_fault), float(heartbeat_count_++),
-                            float(status.command_counter), float(status.controller),
-                            status.can_bus_off ? 1.0f : 0.0f,
-                            float(status.rejected_commands & 0xFF),
-                            float(machine.count() & 0xFF)}));
+    send(can,
+         encode_frame(node_id_, MessageId::heartbeat,
+                      {float(status.state), float(status.fault_bits), float(status.first_fault),
+                       float(heartbeat_count_++), float(status.command_counter),
+                       float(status.controller), status.can_bus_off ? 1.0f : 0.0f,
+                       float(status.rejected_commands & 0xFF), float(machine.count() & 0xFF)}));
   }
   if (k % ticks_per_10Hz_ == ticks_per_10Hz_ / 2) {  // between heartbeats, to spread the load
     send(can, encode_frame(node_id_, MessageId::timing,
@@ -70,28 +68,27 @@ void Telemetry::publish(uint64_t k, hal::CanBus& can, const TickRecord& r,
     send(can, encode_frame(node_id_, MessageId::telemetry_speed_flux,
                            {float(r.omega_est_rad_s), float(r.omega_ref_rad_s),
                             float(r.flux2_est_Wb2), float(r.flux2_ref_Wb2)}));
-    send(can, encode_frame(node_id_, MessageId::telemetry_current,
-                           {float(r.i_A_A), float(r.i_B_A), float(r.load_est_Nm),
-                            float(r.v_bus_V)}));
+    send(can,
+         encode_frame(node_id_, MessageId::telemetry_current,
+                      {float(r.i_A_A), float(r.i_B_A), float(r.load_est_Nm), float(r.v_bus_V)}));
     send(can, encode_frame(node_id_, MessageId::telemetry_voltage,
                            {float(r.u_alpha_V), float(r.u_beta_V), float(sample_count_++)}));
   }
 }
 
 void Telemetry::report_fault(hal::CanBus& can, const DriveStatus& status) noexcept {
-  hal::CanFrame frame = encode_frame(node_id_, MessageId::fault_report,
-                                     {float(status.first_fault), float(status.fault_bits), 0.0f,
-                                      float(status.fault_detail)});
-  protocol::set_raw(frame.data, protocol::kFaultReportSignals[2],
-                    time_ms(status.first_fault_tick));
+  hal::CanFrame frame = encode_frame(
+      node_id_, MessageId::fault_report,
+      {float(status.first_fault), float(status.fault_bits), 0.0f, float(status.fault_detail)});
+  protocol::set_raw(frame.data, protocol::kFaultReportSignals[2], time_ms(status.first_fault_tick));
   send(can, frame);
 }
 
 void Telemetry::acknowledge(hal::CanBus& can, const protocol::Decoded& decoded,
                             uint32_t rejected_total) noexcept {
   send(can, encode_frame(node_id_, MessageId::command_ack,
-                         {float(decoded.message_id), float(decoded.counter),
-                          float(decoded.result), float(std::min<uint32_t>(rejected_total, 0xFFFF))}));
+                         {float(decoded.message_id), float(decoded.counter), float(decoded.result),
+                          float(std::min<uint32_t>(rejected_total, 0xFFFF))}));
 }
 
 }  // namespace imd::firmware

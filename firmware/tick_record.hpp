@@ -11,7 +11,7 @@ struct TickRecord {
   uint64_t tick = 0;
   DriveState state = DriveState::calibrating;
   FaultCode fault = FaultCode::none;  ///< the first latched fault
-  uint16_t fault_bits = 0;           ///< every latched fault, bit n = code n
+  uint16_t fault_bits = 0;            ///< every latched fault, bit n = code n
   // Estimates (rotor frame) at this tick.
   double omega_est_rad_s = 0.0, theta_est_rad = 0.0, flux2_est_Wb2 = 0.0, load_est_Nm = 0.0;
   double flux_est_A_Wb = 0.0, flux_est_B_Wb = 0.0;

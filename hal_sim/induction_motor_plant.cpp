@@ -1,6 +1,8 @@
 #include "hal_sim/induction_motor_plant.hpp"
 
+#include <bit>
 #include <cassert>
+#include <numbers>
 
 #include "hal_sim/rk4.hpp"
 
@@ -21,10 +23,38 @@ PlantState unpack(const StateVector& x) {
 
 }  // namespace
 
+Vec2 phase_axis(int phase) noexcept {
+  constexpr double kHalfSqrt3 = std::numbers::sqrt3 / 2.0;
+  switch (phase) {
+    case 1:
+      return {-0.5, kHalfSqrt3};
+    case 2:
+      return {-0.5, -kHalfSqrt3};
+    default:
+      return {1.0, 0.0};
+  }
+}
+
 InductionMotorPlant::InductionMotorPlant(const control::MotorParameters& motor,
                                          const PlantConfig& config)
     : motor_(motor), k_(control::derive_seed000(motor)), config_(config) {
   assert(config.period_s > 0.0 && config.rk4_substeps >= 1);
+}
+
+void InductionMotorPlant::set_open_phases(unsigned mask) noexcept {
+  assert(mask < 8u);
+  open_phases_ = mask;
+  open_axis_ = Vec2::Zero();
+  for (int phase = 0; phase < 3; ++phase) {
+    if (mask == 1u << phase) open_axis_ = phase_axis(phase);
+  }
+  state_.i_s_alphabeta_A = constrained(state_.i_s_alphabeta_A);
+}
+
+Vec2 InductionMotorPlant::constrained(const Vec2& current) const noexcept {
+  if (open_phases_ == 0) return current;
+  if (std::popcount(open_phases_) >= 2) return Vec2::Zero();  // no current path is left
+  return current - open_axis_.dot(current) * open_axis_;
 }
 
 double InductionMotorPlant::torque_Nm(const PlantState& s) const noexcept {
@@ -52,6 +82,8 @@ StateVector InductionMotorPlant::voltage_fed_derivative(const StateVector& x, co
       -k_.alpha_per_s * flux + p_omega * j_flux + k_.alpha_per_s * motor_.Lm_H * current;
   dx.segment<2>(2) = k_.alpha_per_s * k_.beta_per_H * flux - p_omega * k_.beta_per_H * j_flux -
                      k_.gamma_per_s * current + u / k_.sigma_H;
+  // Floating terminals cancel dI/dt along the open phases' axes.
+  if (open_phases_ != 0) dx.segment<2>(2) = constrained(dx.segment<2>(2));
   dx(4) = (torque - motor_.friction_Nms * omega - load_Nm) / motor_.J_kgm2;
   dx(5) = omega;
   return dx;

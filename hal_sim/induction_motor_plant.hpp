@@ -9,7 +9,11 @@
 /// The stator can be voltage-fed (u held over the period, as an inverter applies it), voltage-
 /// fed through the ideal analog inner feedback (2) evaluated continuously inside the
 /// integration, or current-fed (I~ held in the rotor-aligned frame, as paper 001 assumes).
+///
+/// Phases of the star-connected stator can be open (a fault): their current is then held at zero
+/// by their floating terminals (set_open_phases).
 #include <Eigen/Core>
+#include <optional>
 
 #include "control/frames.hpp"
 #include "control/motor_parameters.hpp"
@@ -25,6 +29,11 @@ struct PlantState {
   double omega_mech_rad_s = 0.0;            ///< mechanical speed w
   double theta_mech_rad = 0.0;              ///< mechanical position th
 };
+
+/// Unit vector of phase `phase`'s axis (0..2: a, b, c) in alpha-beta, (cos 2 pi k/3,
+/// sin 2 pi k/3). With the amplitude-invariant Clarke transform (control/svpwm.hpp), that phase's
+/// current is the projection of the alpha-beta current on it.
+Vec2 phase_axis(int phase) noexcept;
 
 struct PlantConfig {
   double period_s = 1e-4;  ///< one call of a step function advances this much
@@ -45,6 +54,20 @@ class InductionMotorPlant {
   const PlantConfig& config() const noexcept { return config_; }
   int pole_pairs() const noexcept { return motor_.pole_pairs; }
   const control::MotorParameters& motor() const noexcept { return motor_; }
+
+  /// Opens phases from now on. With one phase open and the star point floating, the open
+  /// terminal's potential is free, and a change of it moves the phase-to-neutral voltages along
+  /// that phase's axis only (by 2/3, -1/3, -1/3 of it). It takes whatever value keeps the phase
+  /// current at zero, so the constrained model is (1) with the axis component removed from the
+  /// stator current (here, once) and from dI/dt (in every later voltage-fed and analog-feedback
+  /// step). With two or three phases open no current can flow: it is zeroed, and so is dI/dt.
+  /// The current-fed step ignores open phases. `mask`: bit k for phase k open; 0 reconnects all.
+  void set_open_phases(unsigned mask) noexcept;
+  unsigned open_phases() const noexcept { return open_phases_; }
+  /// Exactly this phase open (0..2), or none with nullopt.
+  void set_open_phase(std::optional<int> phase) noexcept {
+    set_open_phases(phase ? 1u << *phase : 0u);
+  }
 
   /// One period with the stator voltage u held (stationary frame).
   void step_voltage(const Vec2& u_s_alphabeta_V, double load_Nm) noexcept;
@@ -71,19 +94,25 @@ class InductionMotorPlant {
   Vec2 flux_s_alphabeta_Wb() const noexcept { return flux_s_alphabeta_Wb(state_.i_s_alphabeta_A); }
   Vec2 flux_s_alphabeta_Wb(const Vec2& i_s_alphabeta_A) const noexcept;
 
-  /// dx/dt of model (1) for stator voltage u and load torque. Exposed for benchmarks.
+  /// dx/dt of model (1) for stator voltage u and load torque (with open phases, constrained as
+  /// set_open_phases describes). Exposed for benchmarks.
   StateVector voltage_fed_derivative(const StateVector& x, const Vec2& u_s_alphabeta_V,
                                      double load_Nm) const noexcept;
 
  private:
   template <typename VoltageLaw>
   void integrate_voltage_fed(const VoltageLaw& voltage_of_state, double load_Nm) noexcept;
+  /// A stator current (or its derivative) under the open phases' constraint: as is with none
+  /// open, without the open axis' component with one, zero with more.
+  Vec2 constrained(const Vec2& current) const noexcept;
 
   control::MotorParameters motor_;
   control::Seed000Constants k_;
   PlantConfig config_;
   PlantState state_;
   double time_s_ = 0.0;
+  unsigned open_phases_ = 0;
+  Vec2 open_axis_ = Vec2::Zero();  ///< axis of the open phase when exactly one is open
 };
 
 }  // namespace imd::sim

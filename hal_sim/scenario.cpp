@@ -11,6 +11,7 @@
 
 #include "hal_sim/config_error.hpp"
 #include "hal_sim/motor_file.hpp"
+#include "hal_sim/scenario_reader.hpp"
 
 namespace imd::sim {
 
@@ -25,132 +26,10 @@ double SpeedProfile::at(double t_s) const noexcept {
 
 namespace {
 
+using detail::Reader;
+
 const std::set<std::string> kMotorKeys = {"Rs_Ohm", "Ls_H",   "Lm_H",       "Rr_Ohm",
                                           "Lr_H",   "J_kgm2", "pole_pairs", "friction_Nms"};
-
-/// Reads keys by dotted path and remembers which it read, so that anything else in the
-/// document can be reported as unknown.
-class Reader {
- public:
-  Reader(const toml::table& doc, std::string source) : doc_(doc), source_(std::move(source)) {}
-
-  [[noreturn]] void fail(std::string_view path, const std::string& what) const {
-    throw ConfigError(fmt::format("{}: {}: {}", source_, path, what));
-  }
-
-  const toml::node* find(std::string_view path) {
-    read_.insert(std::string(path));
-    return doc_.at_path(path).node();
-  }
-
-  /// A finite number (or the fallback, which may be infinite, when the key is absent).
-  double number(std::string_view path, std::optional<double> fallback) {
-    const toml::node* node = find(path);
-    if (node == nullptr) {
-      if (!fallback) fail(path, "missing key");
-      return *fallback;
-    }
-    double value = 0.0;
-    if (const auto* real = node->as_floating_point()) {
-      value = real->get();
-    } else if (const auto* integer = node->as_integer()) {
-      value = static_cast<double>(integer->get());
-    } else {
-      fail(path, "must be a number");
-    }
-    if (!std::isfinite(value)) fail(path, fmt::format("= {}: must be finite", value));
-    return value;
-  }
-  double positive(std::string_view path, std::optional<double> fallback) {
-    const double value = number(path, fallback);
-    if (!(value > 0.0)) fail(path, fmt::format("= {}: must be > 0", value));
-    return value;
-  }
-  /// A positive number, or inf for "no limit".
-  double positive_or_inf(std::string_view path) {
-    const toml::node* node = find(path);
-    if (node != nullptr && node->is_floating_point() &&
-        node->as_floating_point()->get() == std::numeric_limits<double>::infinity()) {
-      return std::numeric_limits<double>::infinity();
-    }
-    return positive(path, std::numeric_limits<double>::infinity());
-  }
-  double non_negative(std::string_view path, std::optional<double> fallback) {
-    const double value = number(path, fallback);
-    if (!(value >= 0.0)) fail(path, fmt::format("= {}: must be >= 0", value));
-    return value;
-  }
-  int64_t integer(std::string_view path, int64_t fallback, int64_t low, int64_t high) {
-    const toml::node* node = find(path);
-    if (node == nullptr) return fallback;
-    const auto* value = node->as_integer();
-    if (value == nullptr) fail(path, "must be an integer");
-    if (value->get() < low || value->get() > high) {
-      fail(path, fmt::format("= {}: must be in {}..{}", value->get(), low, high));
-    }
-    return value->get();
-  }
-  bool boolean(std::string_view path, bool fallback) {
-    const toml::node* node = find(path);
-    if (node == nullptr) return fallback;
-    const auto* value = node->as_boolean();
-    if (value == nullptr) fail(path, "must be true or false");
-    return value->get();
-  }
-  std::string choice(std::string_view path, std::string fallback,
-                     std::initializer_list<std::string_view> allowed) {
-    const toml::node* node = find(path);
-    if (node == nullptr) return fallback;
-    const auto* value = node->as_string();
-    std::string list;
-    for (auto option : allowed) list += fmt::format("{}\"{}\"", list.empty() ? "" : ", ", option);
-    if (value == nullptr) fail(path, "must be one of " + list);
-    for (auto option : allowed) {
-      if (value->get() == option) return value->get();
-    }
-    fail(path, fmt::format("= \"{}\": must be one of {}", value->get(), list));
-  }
-  std::vector<double> numbers(std::string_view path) {
-    const toml::node* node = find(path);
-    if (node == nullptr) fail(path, "missing key");
-    const auto* array = node->as_array();
-    if (array == nullptr) fail(path, "must be an array of numbers");
-    std::vector<double> values;
-    for (const toml::node& element : *array) {
-      if (const auto* real = element.as_floating_point()) {
-        values.push_back(real->get());
-      } else if (const auto* integer = element.as_integer()) {
-        values.push_back(static_cast<double>(integer->get()));
-      } else {
-        fail(path, "must be an array of numbers");
-      }
-    }
-    return values;
-  }
-  /// Marks a whole table as read (its keys are checked elsewhere).
-  void accept_table(std::string_view path) { accepted_.insert(std::string(path)); }
-
-  /// Throws on the first key that nothing read.
-  void reject_unknown() const { walk(doc_, ""); }
-
- private:
-  void walk(const toml::table& table, const std::string& prefix) const {
-    for (const auto& [key, node] : table) {
-      const std::string path =
-          prefix.empty() ? std::string(key.str()) : prefix + "." + std::string(key.str());
-      if (accepted_.count(path)) continue;
-      if (const auto* child = node.as_table()) {
-        walk(*child, path);
-      } else if (!read_.count(path)) {
-        throw ConfigError(fmt::format("{}: unknown key {}", source_, path));
-      }
-    }
-  }
-
-  const toml::table& doc_;
-  std::string source_;
-  std::set<std::string> read_, accepted_;
-};
 
 /// Parses VALUE as a TOML value; a bare word that is not TOML becomes a string.
 toml::table parse_override_value(const std::string& text) {
@@ -298,6 +177,7 @@ Scenario load_scenario(const std::filesystem::path& path,
   s.precision = r.choice("drive.precision", "double", {"double", "float"});
   s.max_accel_rad_s2 = r.positive_or_inf("drive.max_accel_rad_s2");
   s.compensate_latency = r.boolean("drive.compensate_latency", true);
+  s.command_source = r.choice("drive.command_source", "profile", {"profile", "can"});
   for (auto [key, value] : {std::pair{"drive.speed_reaching_pole", &s.speed_reaching_pole},
                             std::pair{"drive.flux_reaching_pole", &s.flux_reaching_pole}}) {
     *value = r.number(key, 0.0);
@@ -307,7 +187,13 @@ Scenario load_scenario(const std::filesystem::path& path,
 
   // The speed reference drives the DSMC and the iol's outer speed loop; the iol without it
   // follows a torque reference.
-  if (!iol || s.outer_speed_loop || r.find("reference.speed.kind") != nullptr) {
+  // With command_source = "can" it comes only from CAN commands.
+  if (s.command_source == "can") {
+    if (r.present("reference.speed")) {
+      r.fail("reference.speed",
+             "must be absent with drive.command_source = \"can\" (CAN commands set the speed)");
+    }
+  } else if (!iol || s.outer_speed_loop || r.find("reference.speed.kind") != nullptr) {
     read_speed_reference(r, s);
   }
   if (iol) {
@@ -374,6 +260,11 @@ Scenario load_scenario(const std::filesystem::path& path,
     r.fail("metrics.settle_s",
            fmt::format("= {}: must be below simulation.duration_s", s.settle_s));
   }
+
+  detail::read_can(r, s);
+  detail::read_protection(r, s);
+  detail::read_faults(r, s);
+  detail::read_can_commands(r, s);
   r.reject_unknown();
   return s;
 }

@@ -1,12 +1,16 @@
 #pragma once
 /// Scenario files: TOML describing a motor, the drive, references, load, sensors, inverter and
-/// the simulation (docs/scenarios.md). Every key is validated; an unknown key is an error.
+/// the simulation, and the events of a run: faults and CAN commands (docs/scenarios.md). Every
+/// key is validated; an unknown key is an error.
 #include <filesystem>
+#include <limits>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "control/motor_parameters.hpp"
+#include "hal_sim/fault_injection.hpp"
 #include "hal_sim/load_profile.hpp"
 #include "hal_sim/sim_board.hpp"
 
@@ -20,6 +24,40 @@ struct SpeedProfile {
   double at(double t_s) const noexcept;
 };
 
+/// A command the host sends the drive over CAN, as the scenario writes it ([[can_commands]]).
+/// Generic: the message and field names are checked and encoded by the runner against the
+/// protocol table, which names this entry can_commands[index] in its errors.
+struct CanCommandScript {
+  int index = 0;        ///< position in the file's [[can_commands]]
+  double at_s = 0.0;    ///< time of the (first) frame
+  std::string message;  ///< message name in the protocol table
+  /// Signal values in physical units, by signal name (in key order: TOML tables are unordered).
+  std::vector<std::pair<std::string, double>> fields;
+  double every_s = 0.0;  ///< > 0: sent again at at_s + n every_s while <= until_s; 0: once
+  double until_s = std::numeric_limits<double>::infinity();  ///< end of the repeat
+  std::optional<int> counter;  ///< forces the alive counter (0..15): scripts a bad frame
+  bool corrupt_crc = false;    ///< sends a wrong CRC
+  std::optional<int> length;   ///< forces the DLC (0..8)
+};
+
+/// [protection]: the thresholds of the drive's protection checks. An absent value keeps the
+/// runner's default.
+struct ProtectionSettings {
+  std::optional<double> overcurrent_A;    ///< instantaneous phase-current trip
+  std::optional<double> bus_min_V;        ///< below: undervoltage
+  std::optional<double> bus_max_V;        ///< above: overvoltage (> bus_min_V)
+  std::optional<double> overspeed_rad_s;  ///< |estimated speed| trip
+  /// Encoder loss: counts the motion model predicts within one window without a count seen.
+  std::optional<double> encoder_missing_counts;
+  std::optional<int> adc_stuck_ticks;  ///< ticks of identical phase codes that mean stuck, >= 2
+  /// Phase loss: a phase's mean |i| below this share of the largest phase's, in (0, 1) ...
+  std::optional<double> phase_loss_ratio;
+  std::optional<double> phase_loss_min_current_A;  ///< ... while that one carries this much
+  std::optional<double> command_timeout_s;         ///< command watchdog on CAN commands
+  std::optional<double> tick_budget_us;            ///< execution-time budget of a tick
+  std::optional<double> stop_decel_rad_s2;  ///< deceleration of the stop on a disable command
+};
+
 struct Scenario {
   std::string source;  ///< file name, for messages and the summary
   control::MotorParameters motor;
@@ -29,6 +67,9 @@ struct Scenario {
   std::string controller = "dsmc";   ///< "dsmc" (paper 000) or "iol" (paper 001)
   std::string precision = "double";  ///< control arithmetic: "double" or "float"
   double max_accel_rad_s2 = 0.0;     ///< speed reference ramp; inf: none
+  /// Where the speed reference comes from: "profile" ([reference.speed]) or "can" (only from
+  /// CAN commands; [reference.speed] is then absent).
+  std::string command_source = "profile";
   bool compensate_latency = true;    ///< predict over the PWM latency
   double speed_reaching_pole = 0.0;  ///< 0: the paper's deadbeat law
   double flux_reaching_pole = 0.0;
@@ -76,6 +117,14 @@ struct Scenario {
 
   // [metrics]
   double settle_s = 0.5;
+
+  // [can]
+  int can_node_id = 1;             ///< 0..63
+  double telemetry_rate_Hz = 100;  ///< fast telemetry, 10..1000
+
+  ProtectionSettings protection;               ///< [protection]
+  std::vector<FaultInjection> faults;          ///< [[faults]], sorted by at_s (stable)
+  std::vector<CanCommandScript> can_commands;  ///< [[can_commands]], in file order
 };
 
 /// Loads a scenario. `overrides` are "table.key=VALUE" strings (VALUE in TOML syntax; a bare

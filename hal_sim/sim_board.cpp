@@ -1,6 +1,9 @@
 #include "hal_sim/sim_board.hpp"
 
+#include <fmt/format.h>
+
 #include <cmath>
+#include <stdexcept>
 
 #include "control/svpwm.hpp"
 
@@ -13,13 +16,14 @@ SimBoard::SimBoard(const control::MotorParameters& motor, const SimBoardConfig& 
       pwm_(static_cast<float>(config.period_s)),
       encoder_(config.encoder_cpr),
       adc_(adc_model_.scale()),
-      timer_(static_cast<uint32_t>(std::lround(config.period_s * 1e9))) {}
+      timer_(static_cast<uint32_t>(std::lround(config.period_s * 1e9))),
+      v_bus_V_(config.v_bus_V) {}
 
 void SimBoard::latch_sensors() {
   const PlantState& s = plant_.state();
   const auto i_abc = control::inverse_clarke(s.i_s_alphabeta_A);
-  adc_.latch(adc_model_.convert({i_abc[0], i_abc[1], i_abc[2]}, config_.v_bus_V));
-  encoder_.latch(encoder_count(s.theta_mech_rad, config_.encoder_cpr));
+  if (!adc_stuck_) adc_.latch(adc_model_.convert({i_abc[0], i_abc[1], i_abc[2]}, v_bus_V_));
+  if (!encoder_frozen_) encoder_.latch(encoder_count(s.theta_mech_rad, config_.encoder_cpr));
 }
 
 void SimBoard::run_tick() {
@@ -56,7 +60,7 @@ void SimBoard::run_tick() {
     applied_voltage_V_ = plant_.analog_feedback_voltage_V(active_analog_input_V_);
     plant_.step_analog_feedback(active_analog_input_V_, load_now_Nm);
   } else {
-    applied_voltage_V_ = inverter_output_V(active_duty_, config_.v_bus_V);
+    applied_voltage_V_ = inverter_output_V(active_duty_, v_bus_V_);
     plant_.step_voltage(applied_voltage_V_, load_now_Nm);
   }
   if (config_.pwm_latency_ticks != 0) {
@@ -64,6 +68,60 @@ void SimBoard::run_tick() {
     active_analog_input_V_ = written_analog;
     active_current_AB_A_ = written_current;
   }
+}
+
+namespace {
+
+[[noreturn]] void reject(const FaultInjection& fault, const char* key, double value) {
+  throw std::invalid_argument(
+      fmt::format("fault {}: {} = {} is out of range", fault_kind_name(fault.kind), key, value));
+}
+
+void check_phase(const FaultInjection& fault) {
+  if (fault.phase < 0 || fault.phase > 2) reject(fault, "phase", fault.phase);
+}
+
+}  // namespace
+
+void SimBoard::inject(const FaultInjection& fault) {
+  switch (fault.kind) {
+    case FaultKind::overcurrent: {
+      check_phase(fault);
+      if (!(fault.surge_A > 0.0) || !std::isfinite(fault.surge_A)) {
+        reject(fault, "surge_A", fault.surge_A);
+      }
+      PlantState state = plant_.state();
+      state.i_s_alphabeta_A += fault.surge_A * phase_axis(fault.phase);
+      plant_.set_state(state);
+      plant_.set_open_phases(plant_.open_phases());  // an open phase carries no surge
+      break;
+    }
+    case FaultKind::overvoltage:
+    case FaultKind::undervoltage:
+      if (!(fault.bus_V > 0.0) || !std::isfinite(fault.bus_V)) reject(fault, "bus_V", fault.bus_V);
+      v_bus_V_ = fault.bus_V;
+      break;
+    case FaultKind::encoder_loss:
+      encoder_frozen_ = true;
+      break;
+    case FaultKind::adc_stuck:
+      adc_stuck_ = true;
+      break;
+    case FaultKind::phase_loss:
+      check_phase(fault);
+      plant_.set_open_phases(plant_.open_phases() | 1u << fault.phase);
+      break;
+    case FaultKind::overrun:
+      if (!(fault.stall_us > 0.0) || !(fault.stall_us < 1e9)) {
+        reject(fault, "stall_us", fault.stall_us);
+      }
+      timer_.set_stall_ns(static_cast<uint64_t>(std::llround(fault.stall_us * 1e3)));
+      break;
+    case FaultKind::can_silence:
+      can_.silence();
+      break;
+  }
+  injected_.push_back(fault);
 }
 
 }  // namespace imd::sim

@@ -9,9 +9,13 @@
 /// wheeling transient, a fraction of a millisecond, is not modelled). With `current_source` the
 /// stator current is imposed by the ideal current source instead (paper 001's current-fed
 /// plant); the PWM enable still gates it.
+///
+/// Faults (hal_sim/fault_injection.hpp) are injected with inject(), between ticks.
 #include <cstdint>
+#include <vector>
 
 #include "control/motor_parameters.hpp"
+#include "hal_sim/fault_injection.hpp"
 #include "hal_sim/induction_motor_plant.hpp"
 #include "hal_sim/load_profile.hpp"
 #include "hal_sim/sensor_models.hpp"
@@ -30,7 +34,7 @@ struct SimBoardConfig {
   int pwm_latency_ticks = 1;  ///< 0 or 1
   InnerFeedback inner_feedback = InnerFeedback::digital;
   bool current_source = false;  ///< the ideal current source drives the motor
-  double v_bus_V = 311.0;
+  double v_bus_V = 311.0;       ///< nominal DC bus (a bus fault changes the board's v_bus_V())
   uint32_t encoder_cpr = 8192;
   AdcModelConfig adc;
   uint64_t seed = 1;
@@ -60,6 +64,8 @@ class SimBoard {
   double load_Nm() const noexcept { return load_.at(plant_.time_s()); }
   /// Stator voltage the plant saw over the last period (alpha-beta); for the analog device, the
   /// value at the start of the period.
+  /// With an open phase this is the inverter's output; the plant's terminal voltage differs
+  /// from it along the open phase's axis.
   const Vec2& applied_voltage_V() const noexcept { return applied_voltage_V_; }
   /// Torque and stator flux at the start of the last period, with the current of that period
   /// (after the step a current source makes at the period's start).
@@ -68,6 +74,17 @@ class SimBoard {
   const Vec2& start_current_alphabeta_A() const noexcept { return start_current_alphabeta_A_; }
 
   void run_tick();
+
+  /// Applies a fault at once (FaultKind documents each); it lasts to the end of the run. Call
+  /// between ticks: the next run_tick() sees it. Throws std::invalid_argument on a parameter
+  /// out of its range (phase outside 0..2, a non-positive or NaN surge, bus or stall).
+  void inject(const FaultInjection& fault);
+  /// The faults injected so far, in order.
+  const std::vector<FaultInjection>& injected() const noexcept { return injected_; }
+  /// The DC bus now: config().v_bus_V until a bus fault changes it.
+  double v_bus_V() const noexcept { return v_bus_V_; }
+  bool encoder_frozen() const noexcept { return encoder_frozen_; }
+  bool adc_stuck() const noexcept { return adc_stuck_; }
 
  private:
   void latch_sensors();
@@ -91,6 +108,10 @@ class SimBoard {
   Vec2 start_flux_s_alphabeta_Wb_ = Vec2::Zero();
   Vec2 start_current_alphabeta_A_ = Vec2::Zero();
   Vec2 applied_voltage_V_ = Vec2::Zero();
+  double v_bus_V_;
+  bool encoder_frozen_ = false;
+  bool adc_stuck_ = false;
+  std::vector<FaultInjection> injected_;
 };
 
 }  // namespace imd::sim

@@ -19,6 +19,10 @@ bool SimCan::try_receive(hal::CanFrame& frame) noexcept {
 }
 
 bool SimCan::inject(const hal::CanFrame& frame) {
+  if (silenced_) {
+    ++dropped_;
+    return false;
+  }
   if (received_.size() >= kQueueDepth) return false;
   received_.push_back(frame);
   return true;
@@ -29,13 +33,21 @@ std::deque<hal::CanFrame> SimCan::take_sent() {
 }
 
 uint64_t SimTimer::execution_clock_ns() const noexcept {
-  return static_cast<uint64_t>(std::chrono::duration_cast<std::chrono::nanoseconds>(
-                                   std::chrono::steady_clock::now().time_since_epoch())
-                                   .count());
+  const auto host_ns =
+      static_cast<uint64_t>(std::chrono::duration_cast<std::chrono::nanoseconds>(
+                                std::chrono::steady_clock::now().time_since_epoch())
+                                .count());
+  uint64_t stall_ns = 0;
+  if (in_fire_ && reads_in_fire_++ > 0) stall_ns = stall_ns_;
+  return host_ns + stolen_ns_ + stall_ns;
 }
 
 void SimTimer::fire() noexcept {
+  in_fire_ = true;
+  reads_in_fire_ = 0;
   if (handler_ != nullptr) handler_->on_tick();
+  in_fire_ = false;
+  stolen_ns_ += stall_ns_;  // the stolen time has passed for every later read
   ++ticks_;
 }
 

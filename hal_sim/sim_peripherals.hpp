@@ -62,13 +62,23 @@ class SimCan final : public hal::CanBus {
   static constexpr std::size_t kQueueDepth = 64;
   bool try_send(const hal::CanFrame& frame) noexcept override;
   bool try_receive(hal::CanFrame& frame) noexcept override;
-  /// Simulation side: deliver a frame to the firmware; false if its receive queue is full.
+  /// Simulation side: deliver a frame to the firmware; false if it did not arrive (the receive
+  /// queue is full, or the bus is silenced).
   bool inject(const hal::CanFrame& frame);
   /// Simulation side: take the frames the firmware sent since the last call.
   std::deque<hal::CanFrame> take_sent();
 
+  /// Fault: from now on every injected frame is lost (the host side falls silent). Frames
+  /// already received stay; the firmware's sent frames are still collected.
+  void silence() noexcept { silenced_ = true; }
+  bool silenced() const noexcept { return silenced_; }
+  /// Frames lost to the silence so far.
+  uint64_t dropped_frames() const noexcept { return dropped_; }
+
  private:
   std::deque<hal::CanFrame> sent_, received_;
+  bool silenced_ = false;
+  uint64_t dropped_ = 0;
 };
 
 class SimGpio final : public hal::Gpio {
@@ -83,7 +93,8 @@ class SimGpio final : public hal::Gpio {
   bool levels_[kLines] = {};
 };
 
-/// Lock-step timer: the board calls the handler once per simulated period.
+/// Lock-step timer: the board calls the handler once per simulated period. The execution clock
+/// is the host's monotonic clock, plus any time a stall (an overrun fault) has stolen.
 class SimTimer final : public hal::ControlTimer {
  public:
   explicit SimTimer(uint32_t period_ns) : period_ns_(period_ns) {}
@@ -91,14 +102,25 @@ class SimTimer final : public hal::ControlTimer {
   void stop() noexcept override { handler_ = nullptr; }
   uint32_t period_ns() const noexcept override { return period_ns_; }
   uint64_t tick_count() const noexcept override { return ticks_; }
+  /// Host time plus the stalls of past ticks; inside fire(), every read after the first one
+  /// also adds this tick's stall, so a tick measured from its first read takes stall_ns longer.
   uint64_t execution_clock_ns() const noexcept override;
   /// Board side: runs the handler (if started) and counts the period.
   void fire() noexcept;
+
+  /// Fault: from now on every tick takes `stall_ns` longer on the execution clock, as if an
+  /// interrupt of higher priority stole that time inside the tick. 0 removes the stall.
+  void set_stall_ns(uint64_t stall_ns) noexcept { stall_ns_ = stall_ns; }
+  uint64_t stall_ns() const noexcept { return stall_ns_; }
 
  private:
   uint32_t period_ns_;
   uint64_t ticks_ = 0;
   hal::TickHandler* handler_ = nullptr;
+  uint64_t stall_ns_ = 0;
+  uint64_t stolen_ns_ = 0;  ///< stalls of the ticks fired so far: keeps the clock monotonic
+  bool in_fire_ = false;
+  mutable int reads_in_fire_ = 0;
 };
 
 /// The paper's analog inner-feedback device; the board reads the latest input.

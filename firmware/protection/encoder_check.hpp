@@ -32,10 +32,10 @@ class EncoderCheck {
         friction_(T(c.friction_Nms)),
         missing_rad_(T(c.missing_counts * 2.0 * std::numbers::pi / c.counts_per_rev)),
         window_ticks_(static_cast<uint32_t>(std::ceil(c.window_s / c.period_s))),
-        max_jump_counts_(static_cast<int32_t>(
-            std::ceil(1.5 * c.overspeed_rad_s * c.period_s * c.counts_per_rev /
-                      (2.0 * std::numbers::pi))) +
-                         2) {
+        max_jump_counts_(
+            static_cast<int32_t>(std::ceil(1.5 * c.overspeed_rad_s * c.period_s * c.counts_per_rev /
+                                           (2.0 * std::numbers::pi))) +
+            2) {
     reset();
   }
 

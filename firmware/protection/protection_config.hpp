@@ -8,12 +8,12 @@
 namespace imd::firmware {
 
 struct ProtectionConfig {
-  double overcurrent_A = 10.0;  ///< instantaneous, per phase (and any ADC code on a rail)
-  double bus_min_V = 20.0;      ///< below: undervoltage while enabled (also a NaN reading)
-  double bus_max_V = 450.0;     ///< above: overvoltage, in every state
+  double overcurrent_A = 10.0;     ///< instantaneous, per phase (and any ADC code on a rail)
+  double bus_min_V = 20.0;         ///< below: undervoltage while enabled (also a NaN reading)
+  double bus_max_V = 450.0;        ///< above: overvoltage, in every state
   double overspeed_rad_s = 400.0;  ///< |estimated mechanical speed| above: overspeed
   /// Encoder: counts the motion model predicts within one window without a count being seen.
-  double encoder_missing_counts = 6.0;
+  double encoder_missing_counts = 4.0;
   double encoder_window_s = 0.01;  ///< the model is re-anchored to the estimate after this
   /// ADC stuck: ticks with identical phase codes while the applied voltage should have moved
   /// the current by several codes.

@@ -5,7 +5,9 @@
 namespace imd::firmware::protocol {
 namespace {
 
-constexpr const Signal& payload_signal(MessageId id) noexcept { return message(id).signals[2]; }
+constexpr const Signal& payload_signal(MessageId id) noexcept {
+  return message(id).signals[2];
+}
 
 }  // namespace
 

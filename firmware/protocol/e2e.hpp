@@ -30,7 +30,9 @@ constexpr uint8_t e2e_crc(uint16_t can_id, const Payload& data, uint8_t length) 
   return static_cast<uint8_t>(crc8_sae_j1850(buffer, n) ^ 0xFF);
 }
 
-constexpr uint8_t e2e_counter(const Payload& data) noexcept { return data[1] & 0x0F; }
+constexpr uint8_t e2e_counter(const Payload& data) noexcept {
+  return data[1] & 0x0F;
+}
 
 /// Fills in the counter and the CRC of a command frame whose payload is already written.
 constexpr void e2e_protect(uint16_t can_id, Payload& data, uint8_t length,

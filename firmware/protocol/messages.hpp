@@ -64,7 +64,9 @@ struct Message {
 constexpr uint16_t can_id(uint8_t node_id, MessageId id) noexcept {
   return static_cast<uint16_t>(node_id * 32 + static_cast<uint8_t>(id));
 }
-constexpr uint8_t node_of(uint16_t can_id) noexcept { return static_cast<uint8_t>(can_id >> 5); }
+constexpr uint8_t node_of(uint16_t can_id) noexcept {
+  return static_cast<uint8_t>(can_id >> 5);
+}
 constexpr uint8_t message_of(uint16_t can_id) noexcept {
   return static_cast<uint8_t>(can_id & 0x1F);
 }
@@ -72,7 +74,7 @@ constexpr uint8_t message_of(uint16_t can_id) noexcept {
 // --- value tables (kept in step with the firmware's enums by static_asserts where they live)
 
 inline constexpr ValueName kStateValues[] = {
-    {0, "calibrating"}, {1, "idle"}, {2, "magnetizing"},
+    {0, "calibrating"}, {1, "idle"},     {2, "magnetizing"},
     {3, "running"},     {4, "stopping"}, {5, "fault"},
 };
 inline constexpr ValueName kFaultValues[] = {
@@ -94,18 +96,19 @@ inline constexpr ValueName kFaultValues[] = {
 };
 inline constexpr ValueName kControllerValues[] = {{0, "dsmc"}, {1, "iol"}};
 inline constexpr ValueName kCommandResultValues[] = {
-    {0, "accepted"},     {1, "wrong_length"}, {2, "bad_crc"},     {3, "repeated_counter"},
+    {0, "accepted"},      {1, "wrong_length"}, {2, "bad_crc"},     {3, "repeated_counter"},
     {4, "stale_counter"}, {5, "out_of_range"}, {6, "not_allowed"}, {7, "unknown_message"},
 };
 inline constexpr ValueName kTransitionReasonValues[] = {
-    {0, "calibrated"}, {1, "enable"},  {2, "magnetized"}, {3, "disable"},
-    {4, "stopped"},    {5, "fault"},   {6, "clear_faults"},
+    {0, "calibrated"}, {1, "enable"}, {2, "magnetized"},   {3, "disable"},
+    {4, "stopped"},    {5, "fault"},  {6, "clear_faults"},
 };
 
 // --- the E2E header every command starts with
-inline constexpr Signal kE2eCrc{"crc", 0, 8, false, 1, 1, 0.0f, "", "CRC-8 SAE J1850 over the CAN id and bytes 1 to DLC-1"};
-inline constexpr Signal kE2eCounter{"counter", 8, 4, false, 1, 1, 0.0f, "",
-                                    "alive counter, +1 (mod 16) per command frame"};
+inline constexpr Signal kE2eCrc{
+    "crc", 0, 8, false, 1, 1, 0.0f, "", "CRC-8 SAE J1850 over the CAN id and bytes 1 to DLC-1"};
+inline constexpr Signal kE2eCounter{
+    "counter", 8, 4, false, 1, 1, 0.0f, "", "alive counter, +1 (mod 16) per command frame"};
 
 // --- signals, one array per message. Signal order is the telemetry's field order.
 inline constexpr Signal kHeartbeatSignals[] = {
@@ -127,18 +130,21 @@ inline constexpr Signal kFaultReportSignals[] = {
 };
 inline constexpr Signal kEmptyCommandSignals[] = {kE2eCrc, kE2eCounter};
 inline constexpr Signal kSetSpeedSignals[] = {
-    kE2eCrc, kE2eCounter,
+    kE2eCrc,
+    kE2eCounter,
     {"speed_ref_rad_s", 16, 32, true, 1, 1000, 0.0f, "rad/s", "mechanical speed reference"}};
 inline constexpr Signal kSetFluxSignals[] = {
-    kE2eCrc, kE2eCounter,
+    kE2eCrc,
+    kE2eCounter,
     {"flux2_ref_Wb2", 16, 32, false, 1, 1000000, 0.0f, "Wb^2",
      "squared flux reference: rotor flux (dsmc) or stator flux (iol)"}};
 inline constexpr Signal kSelectControllerSignals[] = {
-    kE2eCrc, kE2eCounter,
-    {"controller", 16, 8, false, 1, 1, 0.0f, "", "controller, only while idle",
-     kControllerValues}};
+    kE2eCrc,
+    kE2eCounter,
+    {"controller", 16, 8, false, 1, 1, 0.0f, "", "controller, only while idle", kControllerValues}};
 inline constexpr Signal kSetTelemetryRateSignals[] = {
-    kE2eCrc, kE2eCounter,
+    kE2eCrc,
+    kE2eCounter,
     {"rate_Hz", 16, 16, false, 1, 1, 0.0f, "Hz", "fast telemetry rate, 10..1000"}};
 inline constexpr Signal kCommandAckSignals[] = {
     {"message", 0, 8, false, 1, 1, 0.0f, "", "message id of the command"},
@@ -179,8 +185,8 @@ inline constexpr Signal kTimingSignals[] = {
 };
 
 inline constexpr Message kMessages[] = {
-    {MessageId::emergency_stop, "emergency_stop", 2, Direction::host_to_drive, Timing::on_event,
-     0, "PWM off at once, latched as a fault", kEmptyCommandSignals},
+    {MessageId::emergency_stop, "emergency_stop", 2, Direction::host_to_drive, Timing::on_event, 0,
+     "PWM off at once, latched as a fault", kEmptyCommandSignals},
     {MessageId::heartbeat, "heartbeat", 8, Direction::drive_to_host, Timing::cyclic, 100,
      "state, faults and counters at 10 Hz", kHeartbeatSignals},
     {MessageId::fault_report, "fault_report", 8, Direction::drive_to_host, Timing::on_event, 0,
@@ -220,7 +226,9 @@ constexpr const Message* find_message(uint8_t message_id) noexcept {
   }
   return nullptr;
 }
-constexpr const Message& message(MessageId id) noexcept { return *find_message(uint8_t(id)); }
+constexpr const Message& message(MessageId id) noexcept {
+  return *find_message(uint8_t(id));
+}
 
 /// The index of a signal in its message, or -1.
 constexpr int find_signal(const Message& m, const char* name) noexcept {

@@ -6,9 +6,9 @@
 #include <vector>
 
 #include "control/exact_model_001.hpp"
+#include "firmware/drive_state.hpp"
 #include "hal_sim/scenario.hpp"
 #include "test_motors.hpp"
-#include "firmware/drive_state.hpp"
 #include "tools/drive_sim/scenario_run.hpp"
 
 namespace imd::sim {
@@ -87,12 +87,13 @@ TEST(Seed001Paper, MetricsAndStartUpAreRight) {
   // zero slip, sqrt(F)/Ls = 31.50 A for the 37 kW motor; an ideal source imposes it exactly.
   const Scenario s = scenario("seed001_paper.toml", {"drive.magnetized_fraction=0.5"});
   double magnetizing_current = 0.0;
-  run_scenario(s, {[&](const SimRow& row) {
-                     if (row.state == int(imd::firmware::DriveState::magnetizing) && row.t_s > 0.01) {
-                       magnetizing_current = std::hypot(row.i_alpha_A, row.i_beta_A);
-                     }
-                   },
-                   {}});
+  run_scenario(s,
+               {[&](const SimRow& row) {
+                  if (row.state == int(imd::firmware::DriveState::magnetizing) && row.t_s > 0.01) {
+                    magnetizing_current = std::hypot(row.i_alpha_A, row.i_beta_A);
+                  }
+                },
+                {}});
   EXPECT_NEAR(magnetizing_current, std::sqrt(s.stator_flux2_Wb2) / s.motor.Ls_H, 1e-9);
 }
 

@@ -25,7 +25,7 @@ TEST(StateMachine, FollowsTheGraphAndLogsEveryTransition) {
   EXPECT_TRUE(m.go(DriveState::running, TransitionReason::magnetized, 5));
   EXPECT_FALSE(m.go(DriveState::idle, TransitionReason::disable, 6));  // stop first
   EXPECT_TRUE(m.go(DriveState::fault, TransitionReason::fault, 7));
-  EXPECT_FALSE(m.go(DriveState::fault, TransitionReason::fault, 8));        // already latched
+  EXPECT_FALSE(m.go(DriveState::fault, TransitionReason::fault, 8));         // already latched
   EXPECT_FALSE(m.go(DriveState::magnetizing, TransitionReason::enable, 9));  // clear first
   EXPECT_TRUE(m.go(DriveState::idle, TransitionReason::clear_faults, 10));
   EXPECT_EQ(m.count(), 5u);
@@ -54,7 +54,7 @@ TEST(StateMachine, KeepsTheLastTransitionsWhenTheLogWraps) {
 
 /// The paper-000 motor's inertia and an 8192-count encoder at 10 kHz.
 EncoderCheck<double>::Config encoder_config() {
-  return {8192.0, 1e-4, 0.01, 0.0, 6.0, 0.01, 400.0};
+  return {8192.0, 1e-4, 0.01, 0.0, 4.0, 0.01, 400.0};
 }
 constexpr double kCountRad = 2 * kPi / 8192.0;
 
@@ -74,24 +74,24 @@ TEST(EncoderCheck, AWorkingEncoderAtSpeedPasses) {
 TEST(EncoderCheck, SilenceAtSpeedFailsWithinTheMissingCounts) {
   EncoderCheck<double> check(encoder_config());
   EXPECT_FALSE(check.failed(13, 100.0, 0.0, 0.0));  // 100 rad/s = 13 counts per tick
-  // Frozen: the model predicts 13 counts over the next period, more than the 6 allowed.
+  // Frozen: the model predicts 13 counts over the next period, more than the 4 allowed.
   EXPECT_TRUE(check.failed(0, 100.0, 0.0, 0.0));
 }
 
 TEST(EncoderCheck, AcceleratingWithoutCountsFailsWithinTenMilliseconds) {
   EncoderCheck<double> check(encoder_config());
-  // From rest with 1 N m more than the load on J = 0.01: 100 rad/s^2. Six counts
-  // (4.6e-3 rad) take sqrt(2 * 4.6e-3 / 100) = 9.6 ms.
+  // From rest with 1 N m more than the load on J = 0.01: 100 rad/s^2. Four counts
+  // (3.07e-3 rad) take sqrt(2 * 3.07e-3 / 100) = 7.8 ms.
   int k = 0;
   while (!check.failed(0, 0.0, 0.0, 1.0) && k < 1000) ++k;
-  EXPECT_LE(k, 100);
-  EXPECT_GE(k, 90);
+  EXPECT_LE(k, 80);
+  EXPECT_GE(k, 76);
 }
 
 TEST(EncoderCheck, AHeldRotorWithAnEstimationBiasPasses) {
   // Standstill under load: no counts for 10 s, torque = load up to a 0.5 N m bias. Within one
   // 10 ms window the bias moves the model by 0.5 * 0.01^2 / (2 * 0.01) = 2.5e-3 rad = 3.3
-  // counts < 6, and the window re-anchors to the (zero) estimated speed.
+  // counts < 4, and the window re-anchors to the (zero) estimated speed.
   EncoderCheck<double> check(encoder_config());
   for (int k = 0; k < 100000; ++k) ASSERT_FALSE(check.failed(0, 0.0, 1.0, 1.5)) << k;
 }
@@ -174,8 +174,8 @@ TEST(PhaseLossCheck, AnOpenPhaseIsFoundWithinTwoRevolutions) {
   for (; k < 2000 && lost < 0; ++k) {
     const double angle = 0.01 * k;
     phase_currents(angle, i);
-    i[1] = 0.0;           // phase b open...
-    i[2] = -i[0];         // ...so c carries a's current back
+    i[1] = 0.0;    // phase b open...
+    i[2] = -i[0];  // ...so c carries a's current back
     lost = check.lost_phase(i, angle);
   }
   EXPECT_EQ(lost, 1);

@@ -81,15 +81,13 @@ TEST_F(Decoder, AcceptsAValidSequence) {
 
 TEST_F(Decoder, CounterWrapsAroundSixteen) {
   for (int i = 0; i < 40; ++i) {
-    EXPECT_EQ(decoder.decode(encoder.encode({CommandKind::enable})).result,
-              CommandResult::accepted)
+    EXPECT_EQ(decoder.decode(encoder.encode({CommandKind::enable})).result, CommandResult::accepted)
         << i;
   }
 }
 
 TEST_F(Decoder, RejectsABadCrcAndChangesNothing) {
-  ASSERT_EQ(decoder.decode(encoder.encode({CommandKind::enable})).result,
-            CommandResult::accepted);
+  ASSERT_EQ(decoder.decode(encoder.encode({CommandKind::enable})).result, CommandResult::accepted);
   hal::CanFrame f = encoder.encode({CommandKind::set_speed, 10.0f});
   f.data[3] ^= 0x01;  // one payload bit flipped on the wire
   EXPECT_EQ(decoder.decode(f).result, CommandResult::bad_crc);
@@ -112,8 +110,7 @@ TEST_F(Decoder, RejectsARepeatedCounter) {
 }
 
 TEST_F(Decoder, RejectsAStaleCounter) {
-  EXPECT_EQ(decoder.decode(encoder.encode({CommandKind::enable})).result,
-            CommandResult::accepted);
+  EXPECT_EQ(decoder.decode(encoder.encode({CommandKind::enable})).result, CommandResult::accepted);
   encoder.set_next_counter(0 + kMaxCounterStep + 1);  // more frames lost than allowed
   EXPECT_EQ(decoder.decode(encoder.encode({CommandKind::enable})).result,
             CommandResult::stale_counter);
@@ -121,8 +118,7 @@ TEST_F(Decoder, RejectsAStaleCounter) {
   EXPECT_EQ(decoder.decode(encoder.encode({CommandKind::enable})).result,
             CommandResult::stale_counter);
   encoder.set_next_counter(kMaxCounterStep);  // the largest step allowed
-  EXPECT_EQ(decoder.decode(encoder.encode({CommandKind::enable})).result,
-            CommandResult::accepted);
+  EXPECT_EQ(decoder.decode(encoder.encode({CommandKind::enable})).result, CommandResult::accepted);
 }
 
 TEST_F(Decoder, RejectsAWrongLength) {

@@ -1,7 +1,7 @@
 // drive_sim: runs a scenario of the drive firmware on the simulated board.
 //
 //   drive_sim SCENARIO.toml [--duration-s S] [--csv PATH] [--summary-json PATH]
-//             [--plot PATH.png] [--set table.key=VALUE]...
+//             [--plot PATH.png] [--can-log PATH] [--set table.key=VALUE]...
 //
 // Prints the summary (JSON) on standard output. Exit codes: 0 success, 2 bad input (command
 // line or scenario file), 1 an output could not be written.
@@ -28,7 +28,9 @@ extern char** environ;
 
 #include "hal_sim/config_error.hpp"
 #include "hal_sim/scenario.hpp"
+#include "tools/can_log/candump_log.hpp"
 #include "tools/drive_sim/scenario_run.hpp"
+#include "tools/drive_sim/scripted_commands.hpp"
 
 namespace {
 
@@ -76,13 +78,30 @@ const Column kColumns[] = {
     IMD_COLUMN(iol_boundary),
     IMD_COLUMN(state),
     IMD_COLUMN(saturated),
+    IMD_COLUMN(omega_ref_cmd_rad_s),
+    IMD_COLUMN(flux2_ctrl_est_Wb2),
+    IMD_COLUMN(flux2_ctrl_ref_Wb2),
+    IMD_COLUMN(i_A_est_A),
+    IMD_COLUMN(i_B_est_A),
+    IMD_COLUMN(v_bus_meas_V),
+    IMD_COLUMN(u_alpha_cmd_V),
+    IMD_COLUMN(u_beta_cmd_V),
 };
 #undef IMD_COLUMN
 
 nlohmann::ordered_json summary_json(const imd::sim::Scenario& s, const imd::sim::Summary& r) {
   nlohmann::ordered_json faults = nlohmann::ordered_json::array();
-  for (const auto& f : r.faults)
-    faults.push_back({{"code", f.code}, {"detected_at_s", f.detected_at_s}});
+  auto time = [](double t_s) {  // NaN: it did not happen
+    return std::isfinite(t_s) ? nlohmann::ordered_json(t_s) : nlohmann::ordered_json(nullptr);
+  };
+  for (const auto& f : r.faults) {
+    faults.push_back({{"code", f.code},
+                      {"injected", f.injected.empty() ? nlohmann::ordered_json(nullptr)
+                                                      : nlohmann::ordered_json(f.injected)},
+                      {"injected_at_s", time(f.injected_at_s)},
+                      {"detected_at_s", time(f.detected_at_s)},
+                      {"pwm_off_at_s", time(f.pwm_off_at_s)}});
+  }
   return {{"scenario", s.source},
           {"precision", s.precision},
           {"settle_s", s.settle_s},
@@ -130,7 +149,7 @@ int run_program(std::vector<std::string> args) {
 
 int main(int argc, char** argv) {
   CLI::App app{"Runs the drive firmware on the simulated board for a scenario file."};
-  std::string scenario_path, csv_path, summary_path, plot_path;
+  std::string scenario_path, csv_path, summary_path, plot_path, can_log_path;
   std::optional<double> duration_s;
   std::vector<std::string> overrides;
   app.add_option("scenario", scenario_path, "Scenario file (TOML)")->required();
@@ -140,6 +159,9 @@ int main(int argc, char** argv) {
   app.add_option("--summary-json", summary_path, "Write the summary to this JSON file");
   app.add_option("--plot", plot_path,
                  "Write the paper's Figures 1-5 to this PNG (needs python3-matplotlib)");
+  app.add_option("--can-log", can_log_path,
+                 "Write every CAN frame the firmware sent to this file (candump -L format, "
+                 "interface can0, simulated time)");
   app.add_option("--set", overrides, "Override a scenario key: table.key=VALUE (repeatable)");
   try {
     app.parse(argc, argv);
@@ -152,9 +174,18 @@ int main(int argc, char** argv) {
   imd::sim::Scenario scenario;
   try {
     scenario = imd::sim::load_scenario(scenario_path, overrides);
+    imd::sim::scripted_frames(scenario);  // [[can_commands]] against the protocol table
   } catch (const imd::sim::ConfigError& error) {
     std::cerr << "drive_sim: " << error.what() << '\n';
     return kExitBadInput;
+  }
+  std::FILE* can_log = nullptr;
+  if (!can_log_path.empty()) {
+    can_log = std::fopen(can_log_path.c_str(), "w");
+    if (can_log == nullptr) {
+      std::cerr << "drive_sim: cannot write " << can_log_path << '\n';
+      return kExitOutputFailed;
+    }
   }
 
   // The plot is drawn from the CSV; without --csv a temporary file serves.
@@ -187,6 +218,12 @@ int main(int argc, char** argv) {
       std::fwrite(line.data(), 1, line.size(), csv);
     };
   }
+  if (can_log != nullptr) {
+    callbacks.can_frame = [&](double t_s, const imd::hal::CanFrame& frame) {
+      const std::string line = imd::can_log::format_log_line(t_s, "can0", frame) + "\n";
+      std::fwrite(line.data(), 1, line.size(), can_log);
+    };
+  }
   callbacks.progress = [&](double simulated_s, double wall_s) {
     std::fprintf(stderr, "\rdrive_sim: %.2f / %.2f s simulated, %.1f s wall", simulated_s,
                  scenario.duration_s, wall_s);
@@ -197,6 +234,10 @@ int main(int argc, char** argv) {
     summary = imd::sim::run_scenario(scenario, callbacks);
   } catch (const std::system_error&) {  // fmt reports a failed CSV write (disk full) this way
     written = false;
+  }
+  if (can_log != nullptr && (std::ferror(can_log) != 0 || std::fclose(can_log) != 0)) {
+    std::cerr << "\ndrive_sim: cannot write " << can_log_path << " (disk full?)\n";
+    return kExitOutputFailed;
   }
   if (csv != nullptr) written = std::ferror(csv) == 0 && std::fclose(csv) == 0 && written;
   if (!written) {

@@ -1,5 +1,6 @@
 #include "tools/drive_sim/scenario_run.hpp"
 
+#include <bit>
 #include <chrono>
 #include <cmath>
 
@@ -7,6 +8,7 @@
 #include "control/frames.hpp"
 #include "firmware/drive.hpp"
 #include "hal_sim/sim_board.hpp"
+#include "tools/drive_sim/scripted_commands.hpp"
 
 namespace imd::sim {
 namespace {
@@ -77,12 +79,30 @@ firmware::DriveConfig drive_config(const Scenario& s) {
   c.max_accel_rad_s2 = s.max_accel_rad_s2;
   c.speed_reaching_pole = s.speed_reaching_pole;
   c.flux_reaching_pole = s.flux_reaching_pole;
-  c.auto_enable = true;
-  c.protection.overcurrent_A = 1.5 * s.i_max_A;
-  c.protection.bus_min_V = 0.7 * s.v_bus_V;  // +-30 % of the nominal bus
-  c.protection.bus_max_V = 1.3 * s.v_bus_V;
-  // Lock-step simulation: the host's wall-clock time per tick is not the MCU's.
-  c.protection.tick_budget_ns = 0;
+  // Commands: a profile runs at once; over CAN the script enables the drive.
+  c.commands_over_can = s.command_source == "can";
+  c.auto_enable = !c.commands_over_can;
+  c.node_id = static_cast<uint8_t>(s.can_node_id);
+  c.telemetry_rate_Hz = static_cast<int>(std::lround(s.telemetry_rate_Hz));
+  c.flux2_ref_Wb2 = s.flux2_Wb2;
+  c.stator_flux2_ref_Wb2 = s.stator_flux2_Wb2;
+  c.max_flux2_Wb2 = 2.0 * std::max(s.flux2_Wb2, s.stator_flux2_Wb2);
+  // Protection: defaults from the scenario's board, then its [protection] table.
+  firmware::ProtectionConfig& p = c.protection;
+  const ProtectionSettings& set = s.protection;
+  p.overcurrent_A = set.overcurrent_A.value_or(1.5 * s.i_max_A);
+  p.bus_min_V = set.bus_min_V.value_or(0.7 * s.v_bus_V);  // +-30 % of the nominal bus
+  p.bus_max_V = set.bus_max_V.value_or(1.3 * s.v_bus_V);
+  p.overspeed_rad_s = set.overspeed_rad_s.value_or(p.overspeed_rad_s);
+  p.encoder_missing_counts = set.encoder_missing_counts.value_or(p.encoder_missing_counts);
+  p.adc_stuck_ticks = set.adc_stuck_ticks.value_or(p.adc_stuck_ticks);
+  p.phase_loss_ratio = set.phase_loss_ratio.value_or(p.phase_loss_ratio);
+  p.phase_loss_min_current_A = set.phase_loss_min_current_A.value_or(p.phase_loss_min_current_A);
+  p.command_timeout_s = set.command_timeout_s.value_or(p.command_timeout_s);
+  // Lock-step simulation: the host's wall-clock time per tick is not the MCU's, so the budget
+  // is checked only when the scenario sets one.
+  p.tick_budget_ns = static_cast<uint32_t>(std::lround(set.tick_budget_us.value_or(0.0) * 1e3));
+  c.stop_decel_rad_s2 = set.stop_decel_rad_s2.value_or(c.stop_decel_rad_s2);
   c.adc_calibration_ticks = s.ideal_sensors ? 0 : 256;
   c.adc_offset_limit_A = 0.02 * s.adc.full_scale_A;  // 2 % of full scale (0.2 A on 10 A)
   c.section_iv_load_estimator = s.section_iv;
@@ -108,8 +128,12 @@ Summary run(const Scenario& s, const RunCallbacks& callbacks) {
   const PlantOracle oracle(board);
   firmware::Drive<T> drive(s.motor, drive_config(s),
                            {board.pwm(), board.encoder(), board.adc(), board.timer(),
-                            &board.analog_inner_loop(), &board.current_source()},
+                            &board.analog_inner_loop(), &board.current_source(), &board.can()},
                            references, s.ideal_sensors ? &oracle : nullptr);
+  const std::vector<ScriptedFrame> commands = scripted_frames(s);
+  std::size_t next_command = 0, next_fault = 0;
+  std::vector<std::size_t> unanswered;        // injected faults not yet detected (indices)
+  std::vector<std::size_t> awaiting_pwm_off;  // detected faults with the PWM still on
   board.timer().start(drive);
 
   Summary summary;
@@ -129,24 +153,40 @@ Summary run(const Scenario& s, const RunCallbacks& callbacks) {
     double torque_ref_Nm = 0.0, y2 = 0.0, y2_ref = 0.0;
   } held;  // iol values of the last boundary, held until the next
   uint64_t measured = 0, saturated = 0;
-  firmware::FaultCode last_fault = firmware::FaultCode::none;
+  uint16_t last_fault_bits = 0;
+  bool diverged = false;
   for (uint64_t k = 0; k < ticks; ++k) {
     const double t_s = double(k) * s.sample_period_s;
+    // Host and board events due before this tick: scripted command frames and faults.
+    for (; next_command < commands.size() && commands[next_command].tick <= k; ++next_command) {
+      board.can_side().inject(
+          commands[next_command].frame);  // a full queue loses it, as a bus would
+    }
+    for (; next_fault < s.faults.size() && s.faults[next_fault].at_s <= t_s + 1e-12; ++next_fault) {
+      board.inject(s.faults[next_fault]);
+      unanswered.push_back(summary.faults.size());
+      summary.faults.push_back(
+          {"none", fault_kind_name(s.faults[next_fault].kind), t_s, std::nan(""), std::nan("")});
+    }
     const PlantState truth = board.plant().state();
     if (!truth.flux_r_alphabeta_Wb.allFinite() || !truth.i_s_alphabeta_A.allFinite() ||
         !std::isfinite(truth.omega_mech_rad_s) || !std::isfinite(truth.theta_mech_rad)) {
-      summary.faults.push_back({"plant_diverged", t_s});  // the run ends here
+      summary.faults.push_back({"plant_diverged", "", std::nan(""), t_s, std::nan("")});
       summary.ticks = k;
+      diverged = true;
       break;
     }
     const double load_Nm = board.load_Nm();
     board.run_tick();
     const firmware::TickRecord& rec = drive.record();
+    for (const hal::CanFrame& frame : board.can_side().take_sent()) {
+      if (callbacks.can_frame) callbacks.can_frame(t_s, frame);
+    }
 
     SimRow row;
     row.t_s = t_s;
     row.omega_mech_rad_s = truth.omega_mech_rad_s;
-    row.omega_ref_rad_s = s.speed.at(t_s);
+    row.omega_ref_rad_s = s.command_source == "can" ? rec.omega_ref_rad_s : s.speed.at(t_s);
     row.omega_est_rad_s = rec.omega_est_rad_s;
     const auto rotor = control::Rotation<double>::from_angle(m.pole_pairs * truth.theta_mech_rad);
     const Vec2 flux_AB = rotor.apply_inverse(truth.flux_r_alphabeta_Wb);
@@ -201,17 +241,45 @@ Summary run(const Scenario& s, const RunCallbacks& callbacks) {
       row.torque_ref_Nm = held.torque_ref_Nm;
     }
     row.state = static_cast<int>(rec.state);
+    row.omega_ref_cmd_rad_s = rec.omega_ref_rad_s;
+    row.flux2_ctrl_est_Wb2 = rec.controlled_flux2_Wb2;
+    row.flux2_ctrl_ref_Wb2 = rec.controlled_flux2_ref_Wb2;
+    row.i_A_est_A = rec.i_A_A;
+    row.i_B_est_A = rec.i_B_A;
+    row.v_bus_meas_V = rec.v_bus_V;
+    row.u_alpha_cmd_V = rec.u_alpha_V;
+    row.u_beta_cmd_V = rec.u_beta_V;
     row.saturated = rec.speed_saturated || rec.flux_saturated || rec.voltage_clipped;
 
     const double current_A = truth.i_s_alphabeta_A.norm();
     summary.i_peak_total_A = std::max(summary.i_peak_total_A, current_A);
     if (summary.running_from_s < 0 && rec.state == firmware::DriveState::running)
       summary.running_from_s = t_s;
-    if (rec.fault != last_fault) {
-      summary.faults.push_back({firmware::fault_name(rec.fault), t_s});
-      last_fault = rec.fault;
+    // Faults the drive latched this tick, the first one first; each answers the oldest
+    // injected fault still unanswered.
+    for (uint16_t fresh = rec.fault_bits & ~last_fault_bits; fresh != 0;) {
+      int code = std::countr_zero(fresh);
+      if ((fresh & (1u << unsigned(rec.fault))) != 0) code = int(rec.fault);
+      fresh = uint16_t(fresh & ~(1u << unsigned(code)));
+      std::size_t event = summary.faults.size();
+      if (!unanswered.empty()) {
+        event = unanswered.front();
+        unanswered.erase(unanswered.begin());
+      } else {
+        summary.faults.push_back({});
+      }
+      summary.faults[event].code = firmware::fault_name(firmware::FaultCode(code));
+      summary.faults[event].detected_at_s = t_s;
+      awaiting_pwm_off.push_back(event);
     }
-    if (t_s > s.settle_s) {
+    last_fault_bits = rec.fault_bits;
+    if (!board.pwm().enabled()) {
+      for (const std::size_t event : awaiting_pwm_off) summary.faults[event].pwm_off_at_s = t_s;
+      awaiting_pwm_off.clear();
+    }
+    // Over CAN the drive is stopped and started at the host's will: only running ticks count.
+    const bool measuring = s.command_source != "can" || rec.state == firmware::DriveState::running;
+    if (t_s > s.settle_s && measuring) {
       const double speed_err = row.omega_mech_rad_s - row.omega_ref_rad_s;
       const double flux_err =
           iol ? row.stator_flux2_Wb2 - row.stator_flux2_ref_Wb2 : row.flux2_Wb2 - row.flux2_ref_Wb2;
@@ -233,8 +301,7 @@ Summary run(const Scenario& s, const RunCallbacks& callbacks) {
       }
     }
   }
-  if (summary.faults.empty() || summary.faults.back().code != "plant_diverged")
-    summary.ticks = ticks;
+  if (!diverged) summary.ticks = ticks;
   summary.simulated_s = double(summary.ticks) * s.sample_period_s;
   summary.wall_time_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();

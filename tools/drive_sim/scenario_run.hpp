@@ -1,11 +1,14 @@
 #pragma once
 /// Runs a scenario: the drive firmware on the simulated board, in lock-step, and the metrics
 /// of docs/scenarios.md. Shared by drive_sim and the sim-tier tests.
+#include <cmath>
 #include <cstdint>
 #include <functional>
 #include <string>
+#include <utility>
 #include <vector>
 
+#include "hal/can_bus.hpp"
 #include "hal_sim/scenario.hpp"
 
 namespace imd::sim {
@@ -26,14 +29,25 @@ struct SimRow {
   double torque_ref_Nm = 0.0, y2 = 0.0, y2_ref = 0.0, stator_flux2_Wb2 = 0.0;
   double stator_flux2_ref_Wb2 = 0.0;
   double i_hold_err_A = 0.0;  ///< |i_AB - i_cmd|: departure from the zero-order hold (iol)
+  // What the drive's telemetry carries (the CAN round trip compares against these).
+  double omega_ref_cmd_rad_s = 0.0;  ///< the speed reference the law aimed at (after the ramp)
+  double flux2_ctrl_est_Wb2 = 0.0, flux2_ctrl_ref_Wb2 = 0.0;  ///< the controlled flux
+  double i_A_est_A = 0.0, i_B_est_A = 0.0;  ///< estimated stator current, rotor frame
+  double v_bus_meas_V = 0.0;
+  double u_alpha_cmd_V = 0.0, u_beta_cmd_V = 0.0;  ///< stator voltage command
   bool iol_boundary = false;
   int state = 0;
   bool saturated = false;
 };
 
+/// A fault the drive latched (or the plant diverging). Times are tick times; NaN when it did
+/// not happen (a fault that was not injected, a PWM that stayed on).
 struct FaultEvent {
-  std::string code;
+  std::string code;      ///< the drive's fault code, e.g. "encoder"
+  std::string injected;  ///< the injected fault it answered ([[faults]] kind), or empty
+  double injected_at_s = std::nan("");
   double detected_at_s = 0.0;
+  double pwm_off_at_s = std::nan("");
 };
 
 /// Metrics over t > settle_s from the plant's true state (i_peak_total_A: the whole run). NaN
@@ -54,9 +68,15 @@ struct Summary {
 };
 
 struct RunCallbacks {
-  std::function<void(const SimRow&)> row;  ///< every tick, if set
-  /// About once per wall-clock second: simulated time so far.
-  std::function<void(double simulated_s, double wall_s)> progress;
+  using Row = std::function<void(const SimRow&)>;
+  using Progress = std::function<void(double simulated_s, double wall_s)>;
+  using Frame = std::function<void(double t_s, const hal::CanFrame&)>;
+  RunCallbacks(Row row_ = {}, Progress progress_ = {}, Frame can_frame_ = {})
+      : row(std::move(row_)), progress(std::move(progress_)), can_frame(std::move(can_frame_)) {}
+
+  Row row;            ///< every tick, if set
+  Progress progress;  ///< about once per wall-clock second: simulated time so far
+  Frame can_frame;    ///< every frame the firmware sent, with the time of the tick that sent it
 };
 
 Summary run_scenario(const Scenario& scenario, const RunCallbacks& callbacks = {});
