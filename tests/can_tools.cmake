@@ -1,1 +1,70 @@
-# CAN tool tests (filled in below)
+# The host CAN tools: candump -L logs (tools/can_log), SocketCAN (hal/linux) and drive_monitor.
+# Test names contain can_log, socketcan or monitor; all are in the unit tier.
+imd_add_test(test_can_log unit unit/test_can_log.cpp)
+target_link_libraries(test_can_log PRIVATE imd_can_log)
+imd_add_test(test_drive_monitor unit unit/test_drive_monitor.cpp)
+target_link_libraries(test_drive_monitor PRIVATE imd_drive_monitor)
+if(TARGET imd_hal_linux)
+  imd_add_test(test_socketcan_bus unit unit/test_socketcan_bus.cpp)
+  target_link_libraries(test_socketcan_bus PRIVATE imd_hal_linux)
+endif()
+
+# drive_monitor: exit code 2 and a clear message on bad input (the interface is checked on a
+# machine that may have no CAN at all: either message is clear), decoding of a recorded log.
+if(TARGET drive_monitor)
+  set(CAN_DATA ${CMAKE_CURRENT_SOURCE_DIR}/data/can)
+  set(NO_CAN_IFACE "drive_monitor: vcan9: (socket\\(PF_CAN\\): .*support in this kernel|no such CAN interface)")
+  function(imd_monitor_test NAME CODE PATTERN)
+    imd_tool_test(drive_monitor ${NAME} ${CODE} ${PATTERN} ${ARGN})
+  endfunction()
+  imd_monitor_test(drive_monitor_help 0 "watch" --help)
+  imd_monitor_test(drive_monitor_no_subcommand 2 "A subcommand is required")
+  imd_monitor_test(drive_monitor_no_source 2 "drive_monitor: watch: give --can IFACE or --log FILE"
+                   watch)
+  imd_monitor_test(drive_monitor_bad_interface 2 "${NO_CAN_IFACE}" watch --can vcan9)
+  imd_monitor_test(drive_monitor_send_bad_interface 2 "${NO_CAN_IFACE}"
+                   send --can vcan9 --node 1 enable)
+  imd_monitor_test(drive_monitor_long_interface_name 2 "interface name longer than 15 characters"
+                   watch --can interface_name_17)
+  imd_monitor_test(drive_monitor_missing_log 2 "drive_monitor: /nonexistent.log: cannot open file"
+                   watch --log /nonexistent.log)
+  imd_monitor_test(drive_monitor_bad_log_line 2
+                   "drive_monitor: .*/bad_line.log:3: data '0801000' has an odd number of hex digits"
+                   watch --log ${CAN_DATA}/bad_line.log)
+  imd_monitor_test(drive_monitor_extended_id 2
+                   "extended_id.log:2: extended identifier '18FF0001' \\(29 bits\\): not supported"
+                   watch --log ${CAN_DATA}/extended_id.log)
+  imd_monitor_test(drive_monitor_log_table 0
+                   "last ack +set_speed counter 3: accepted, rejected_total 1"
+                   watch --log ${CAN_DATA}/monitor_sample.log)
+  imd_monitor_test(drive_monitor_log_csv 0
+                   "^0\\.130300,37\\.02,100\\.00,0\\.8099,0\\.8100,4\\.50,-2\\.25,0\\.50,301\\.7,30\\.3,-20\\.2,3,running,none$"
+                   watch --log ${CAN_DATA}/monitor_sample.log --csv - --no-table)
+  imd_monitor_test(drive_monitor_log_duration 0 "samples +1 rows"
+                   watch --log ${CAN_DATA}/monitor_sample.log --duration-s 0.12)
+  imd_monitor_test(drive_monitor_bad_duration 2 "duration-s: must be a time in \\(0, 1e7\\] s, got -1"
+                   watch --log ${CAN_DATA}/monitor_sample.log --duration-s -1)
+  imd_monitor_test(drive_monitor_bad_node 2 "--node: Value 64 not in range 0 to 63"
+                   watch --log ${CAN_DATA}/monitor_sample.log --node 64)
+  imd_monitor_test(drive_monitor_send_not_a_number 2 "drive_monitor: set-speed: 'fast' is not a number"
+                   send --can vcan9 --node 1 set-speed fast)
+  imd_monitor_test(drive_monitor_send_unrepresentable 2 "set-speed: 3e6 cannot be represented"
+                   send --can vcan9 --node 1 set-speed 3e6)
+  imd_monitor_test(drive_monitor_send_unknown_controller 2
+                   "unknown controller 'pid' \\(known: dsmc, iol\\)"
+                   send --can vcan9 --node 1 select-controller pid)
+  imd_monitor_test(drive_monitor_send_bad_rate 2 "set-telemetry-rate: 5 must be a whole number of Hz"
+                   send --can vcan9 --node 1 set-telemetry-rate 5)
+  imd_monitor_test(drive_monitor_send_unknown_command 2 "unknown command 'reboot'"
+                   send --can vcan9 --node 1 reboot)
+  imd_monitor_test(drive_monitor_send_missing_value 2 "set-speed needs a value \\(RAD_S\\)"
+                   send --can vcan9 --node 1 set-speed)
+  imd_monitor_test(drive_monitor_send_bad_counter 2 "--counter: Value 16 not in range 0 to 15"
+                   send --can vcan9 --node 1 --counter 16 enable)
+endif()
+
+# libFuzzer harnesses (clang only): the fuzz preset turns them on.
+option(IMD_BUILD_FUZZERS "Build the libFuzzer harnesses (clang; see the fuzz preset)" OFF)
+if(IMD_BUILD_FUZZERS)
+  add_subdirectory(fuzz)
+endif()

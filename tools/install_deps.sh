@@ -1,10 +1,10 @@
 #!/bin/sh
 # Installs the Debian 12 packages the build and the tests need (with --plot, those the main
-# job's plots need; with --cortex-m, the bare-metal Cortex-M4F toolchain) if any is missing. Idempotent: when everything is present it changes
-# nothing and needs no network.
+# job's plots need; with --cortex-m, the bare-metal Cortex-M4F toolchain) if any is missing.
+# Idempotent: when everything is present it changes nothing and needs no network.
 set -eu
 packages="g++ cmake ninja-build libeigen3-dev libtomlplusplus-dev libcli11-dev nlohmann-json3-dev
-libfmt-dev libgtest-dev libbenchmark-dev"
+libfmt-dev libgtest-dev libbenchmark-dev python3"
 for option in "$@"; do
   case "$option" in
     --plot) packages="$packages python3 python3-numpy python3-matplotlib" ;;

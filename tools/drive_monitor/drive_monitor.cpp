@@ -1,0 +1,321 @@
+// drive_monitor: watches a drive's CAN frames (live, or from a candump -L log) and sends it
+// commands.
+//
+//   drive_monitor watch (--can IFACE | --log FILE) [--node N] [--csv PATH] [--table | --no-table]
+//                       [--duration-s S]
+//   drive_monitor send --can IFACE --node N COMMAND [VALUE] [--counter C] [--wait-heartbeat-s S]
+//                      [--wait-ack-s S]
+//
+// watch decodes node N's frames (default 1); the CSV's time_s is the log's timestamp, or with
+// --can the seconds since watch started. send learns the alive counter from the heartbeat.
+//
+// Exit codes: 0 success, 1 the CSV could not be written, 2 bad input (command line, interface,
+// log file), 3 command rejected, 4 no heartbeat or no acknowledgement.
+#include <poll.h>
+#include <unistd.h>
+#include <CLI/CLI.hpp>
+
+#include <cerrno>
+#include <chrono>
+#include <cmath>
+#include <csignal>
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <iostream>
+#include <sstream>
+#include <string>
+
+#include "hal/linux/socketcan_bus.hpp"
+#include "tools/can_log/candump_log.hpp"
+#include "tools/drive_monitor/monitor.hpp"
+#include "tools/drive_monitor/send_command.hpp"
+#include "tools/drive_monitor/status_table.hpp"
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+using imd::monitor::DriveMonitor;
+using imd::monitor::TelemetryRow;
+
+constexpr int kExitOutputError = 1;
+constexpr int kExitBadInput = 2;
+constexpr int kExitRejected = 3;
+constexpr int kExitNoAnswer = 4;
+constexpr auto kRefreshPeriod = std::chrono::milliseconds(200);
+
+volatile std::sig_atomic_t g_stop = 0;
+extern "C" void on_signal(int) {
+  g_stop = 1;
+}
+
+std::string seconds_text(double seconds) {
+  std::ostringstream text;
+  text << seconds;
+  return text.str();
+}
+
+int fail(const std::string& message, int code = kExitBadInput) {
+  std::cerr << "drive_monitor: " << message << '\n';
+  return code;
+}
+
+/// A duration in (0, 1e7] s; CLI11's PositiveNumber lets NaN through.
+const CLI::Validator kSeconds(
+    [](std::string& text) -> std::string {
+      char* end = nullptr;
+      const double value = std::strtod(text.c_str(), &end);
+      if (end == text.c_str() || *end != '\0') return "must be a number, got " + text;
+      if (!(value > 0.0 && value <= 1e7)) return "must be a time in (0, 1e7] s, got " + text;
+      return {};
+    },
+    "SECONDS");
+
+struct WatchOptions {
+  std::string can;
+  std::string log;
+  std::string csv;
+  int node = 1;
+  bool table = false;
+  bool no_table = false;
+  double duration_s = 0.0;  ///< 0: until interrupted (live) or the end of the log
+};
+
+struct SendOptions {
+  std::string can;
+  int node = 1;
+  std::string command;
+  std::optional<std::string> value;
+  int counter = -1;
+  double wait_heartbeat_s = 0.5;
+  double wait_ack_s = 0.5;
+};
+
+/// The CSV output, when asked for ("-": standard output).
+class CsvOutput {
+ public:
+  bool open(const std::string& path, std::string& error) {
+    if (path.empty()) return true;
+    if (path != "-") {
+      file_.open(path, std::ios::out | std::ios::trunc);
+      if (!file_.is_open()) {
+        error = path + ": cannot open file for writing";
+        return false;
+      }
+    }
+    stream_ = path == "-" ? &std::cout : &file_;
+    *stream_ << imd::monitor::csv_header() << '\n';
+    return true;
+  }
+  void write(const std::optional<TelemetryRow>& row) {
+    if (row && stream_ != nullptr) *stream_ << imd::monitor::csv_row(*row) << '\n';
+  }
+  /// False if a write failed.
+  bool good() { return stream_ == nullptr || static_cast<bool>(stream_->flush()); }
+
+ private:
+  std::ofstream file_;
+  std::ostream* stream_ = nullptr;
+};
+
+/// Waits until the socket has data or `deadline` passes (or a signal arrives).
+void wait_readable(const imd::hal::SocketCanBus& bus, Clock::time_point deadline) {
+  const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - Clock::now());
+  pollfd fd{bus.native_handle(), POLLIN, 0};
+  ::poll(&fd, 1, static_cast<int>(std::max<int64_t>(0, left.count()) + 1));
+}
+
+imd::monitor::BusInfo bus_info(const imd::hal::SocketCanBus& bus) {
+  const imd::hal::CanErrorState& e = bus.errors();
+  return {e.error_frames, e.bus_off_events, e.bus_off,
+          imd::hal::describe_error_class(e.last_error_class), bus.unsupported_frames()};
+}
+
+/// Redraws the table in place: cursor home, each line cleared to its end, the rest erased.
+void redraw(const std::string& table) {
+  std::string out = "\x1b[H";
+  for (std::size_t start = 0; start < table.size();) {
+    const std::size_t end = table.find('\n', start);
+    out += table.substr(start, end - start) + "\x1b[K\n";
+    start = end == std::string::npos ? table.size() : end + 1;
+  }
+  std::cout << out << "\x1b[J" << std::flush;
+}
+
+int watch_log(const WatchOptions& o) {
+  imd::can_log::LogReader reader(o.log);
+  if (!reader.is_open()) return fail(reader.error());
+  CsvOutput csv;
+  std::string error;
+  if (!csv.open(o.csv, error)) return fail(error);
+  DriveMonitor monitor(static_cast<uint8_t>(o.node));
+  imd::can_log::ParsedLine line;
+  double first_s = -1.0;
+  while (reader.next(line)) {
+    if (first_s < 0.0) first_s = line.time_s;
+    if (o.duration_s > 0.0 && line.time_s - first_s > o.duration_s) break;
+    if (!line.remote) csv.write(monitor.feed(line.time_s, line.frame));
+  }
+  if (!reader.error().empty()) return fail(reader.error());
+  if (!csv.good()) return fail(o.csv + ": write error", kExitOutputError);
+  if (!o.no_table) {
+    std::cout << imd::monitor::render_table(monitor.status(), monitor.node_id(), o.log);
+  }
+  return 0;
+}
+
+int watch_live(const WatchOptions& o) {
+  std::string error;
+  const auto bus = imd::hal::SocketCanBus::open(o.can, error);
+  if (!bus) return fail(error);
+  CsvOutput csv;
+  if (!csv.open(o.csv, error)) return fail(error);
+  std::signal(SIGINT, on_signal);
+  std::signal(SIGTERM, on_signal);
+  const bool live_table = o.table || (!o.no_table && ::isatty(STDOUT_FILENO) == 1);
+  if (live_table) std::cout << "\x1b[2J";
+  DriveMonitor monitor(static_cast<uint8_t>(o.node));
+  const Clock::time_point start = Clock::now();
+  const Clock::time_point end = o.duration_s > 0.0
+                                    ? start + std::chrono::duration_cast<Clock::duration>(
+                                                  std::chrono::duration<double>(o.duration_s))
+                                    : Clock::time_point::max();
+  Clock::time_point next_refresh = start;
+  while (g_stop == 0 && Clock::now() < end) {
+    wait_readable(*bus, std::min(end, next_refresh));
+    imd::hal::CanFrame frame;
+    while (bus->try_receive(frame)) {
+      const double t_s = std::chrono::duration<double>(Clock::now() - start).count();
+      csv.write(monitor.feed(t_s, frame));
+    }
+    if (bus->last_errno() == ENODEV || bus->last_errno() == ENETDOWN) {
+      return fail(o.can + ": receive failed: " + std::strerror(bus->last_errno()));
+    }
+    if (Clock::now() >= next_refresh) {
+      next_refresh = Clock::now() + kRefreshPeriod;
+      const imd::monitor::BusInfo info = bus_info(*bus);
+      if (live_table) redraw(render_table(monitor.status(), monitor.node_id(), o.can, &info));
+    }
+  }
+  const imd::monitor::BusInfo info = bus_info(*bus);
+  const std::string table = render_table(monitor.status(), monitor.node_id(), o.can, &info);
+  if (live_table) {
+    redraw(table);
+  } else if (!o.no_table) {
+    std::cout << table;
+  }
+  if (!csv.good()) return fail(o.csv + ": write error", kExitOutputError);
+  return 0;
+}
+
+/// Receives until `accept(frame)` returns true or `wait_s` passes.
+template <typename Accept>
+bool receive_until(imd::hal::SocketCanBus& bus, double wait_s, Accept accept) {
+  const Clock::time_point deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(
+                                                        std::chrono::duration<double>(wait_s));
+  imd::hal::CanFrame frame;
+  while (g_stop == 0) {
+    while (bus.try_receive(frame)) {
+      if (accept(frame)) return true;
+    }
+    if (Clock::now() >= deadline) return false;
+    wait_readable(bus, deadline);
+  }
+  return false;
+}
+
+int send(const SendOptions& o) {
+  namespace protocol = imd::firmware::protocol;
+  std::string error;
+  const auto command = imd::monitor::parse_command(o.command, o.value, error);
+  if (!command) return fail(error);
+  const auto bus = imd::hal::SocketCanBus::open(o.can, error);
+  if (!bus) return fail(error);
+  const auto node = static_cast<uint8_t>(o.node);
+  std::signal(SIGINT, on_signal);
+
+  uint8_t counter = static_cast<uint8_t>(o.counter);
+  if (o.counter < 0) {
+    std::optional<uint8_t> last;
+    receive_until(*bus, o.wait_heartbeat_s, [&](const imd::hal::CanFrame& f) {
+      last = imd::monitor::heartbeat_command_counter(f, node);
+      return last.has_value();
+    });
+    if (!last) {
+      return fail("no heartbeat from node " + std::to_string(o.node) + " on " + o.can + " within " +
+                      seconds_text(o.wait_heartbeat_s) + " s (use --counter C to send without one)",
+                  kExitNoAnswer);
+    }
+    counter = static_cast<uint8_t>((*last + 1) & 0x0F);
+  }
+  protocol::CommandEncoder encoder(node, counter);
+  const imd::hal::CanFrame frame = encoder.encode(*command);
+  const auto message_id = protocol::message_of(frame.id);
+  receive_until(*bus, 0.0, [](const imd::hal::CanFrame&) { return false; });  // drop old frames
+  if (!bus->try_send(frame)) {
+    return fail(o.can + ": could not send (transmit queue full or interface down)", kExitNoAnswer);
+  }
+  const std::string sent = imd::monitor::describe_command(*command) + " to node " +
+                           std::to_string(o.node) + ", counter " + std::to_string(counter);
+  std::optional<imd::monitor::Ack> ack;
+  receive_until(*bus, o.wait_ack_s, [&](const imd::hal::CanFrame& f) {
+    ack = imd::monitor::match_ack(f, node, message_id, counter);
+    return ack.has_value();
+  });
+  if (!ack) return fail("sent " + sent + ": no command_ack", kExitNoAnswer);
+  std::cout << "sent " << sent << ": " << imd::monitor::result_name(ack->result)
+            << " (rejected_total " << ack->rejected_total << ")\n";
+  return ack->result == protocol::CommandResult::accepted ? 0 : kExitRejected;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"Watches an induction-motor drive on CAN and sends it commands."};
+  app.require_subcommand(1);
+
+  WatchOptions w;
+  CLI::App* watch = app.add_subcommand("watch", "Decode the drive's frames: status table, CSV");
+  auto* can = watch->add_option("--can", w.can, "CAN interface (SocketCAN), e.g. can0");
+  watch->add_option("--log", w.log, "candump -L log file instead of an interface")->excludes(can);
+  watch->add_option("--node", w.node, "Node id of the drive")
+      ->check(CLI::Range(0, imd::firmware::protocol::kMaxNodeId))
+      ->capture_default_str();
+  watch->add_option("--csv", w.csv,
+                    "Write one row per fast-telemetry sample to this file ('-': stdout)");
+  auto* table = watch->add_flag("--table", w.table, "Refresh the table even if not a terminal");
+  watch->add_flag("--no-table", w.no_table, "Print no table")->excludes(table);
+  watch->add_option("--duration-s", w.duration_s, "Stop after this time (log time with --log)")
+      ->check(kSeconds);
+
+  SendOptions s;
+  CLI::App* send_cmd = app.add_subcommand("send", "Send one command and print its ack");
+  send_cmd->add_option("--can", s.can, "CAN interface (SocketCAN), e.g. can0")->required();
+  send_cmd->add_option("--node", s.node, "Node id of the drive")
+      ->check(CLI::Range(0, imd::firmware::protocol::kMaxNodeId))
+      ->required();
+  send_cmd->add_option("command", s.command, imd::monitor::command_usage())->required();
+  std::string value;
+  CLI::Option* value_option = send_cmd->add_option("value", value, "The command's value");
+  send_cmd->add_option("--counter", s.counter, "Alive counter to use (default: heartbeat's + 1)")
+      ->check(CLI::Range(0, 15));
+  send_cmd->add_option("--wait-heartbeat-s", s.wait_heartbeat_s, "How long to wait for it")
+      ->check(kSeconds)
+      ->capture_default_str();
+  send_cmd->add_option("--wait-ack-s", s.wait_ack_s, "How long to wait for the command_ack")
+      ->check(kSeconds)
+      ->capture_default_str();
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& error) {
+    const int code = app.exit(error);
+    return code == 0 ? 0 : kExitBadInput;
+  }
+  if (watch->parsed()) {
+    if (w.can.empty() && w.log.empty()) return fail("watch: give --can IFACE or --log FILE");
+    return w.log.empty() ? watch_live(w) : watch_log(w);
+  }
+  if (value_option->count() > 0) s.value = value;
+  return send(s);
+}
