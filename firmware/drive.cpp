@@ -441,6 +441,11 @@ void Drive<T>::on_tick() noexcept {
       hw_.pwm.disable();
       record_.u_alpha_V = record_.u_beta_V = 0.0;
       u_written_V_ = Vec2::Zero();
+      // Telemetry shows what the drive would aim at once enabled.
+      const Reference ref = references_.at_tick(k);
+      record_.omega_ref_rad_s = ref.omega_mech_rad_s;
+      record_.flux2_ref_Wb2 = ref.flux2_Wb2;
+      record_.controlled_flux2_ref_Wb2 = double(magnetized_flux2_ref(ref));
     }
     if (!hw_.pwm.enabled()) v = Vec2::Zero();
 

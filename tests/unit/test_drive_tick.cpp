@@ -55,7 +55,7 @@ void run_without_allocation() {
   board_config.adc.noise_A = 0.01;
   sim::SimBoard board(test::test_motors()[0].parameters, board_config);
   DriveConfig config;
-  config.auto_enable = true;              // no enable command on this bench
+  config.auto_enable = true;             // no enable command on this bench
   config.protection.tick_budget_ns = 0;  // wall-clock time on a shared host is not the MCU's
   config.i_max_A = 6.0;
   config.protection.overcurrent_A = 9.0;
@@ -81,7 +81,7 @@ TEST(DriveTick, NeverAllocatesInFloat) {
 TEST(DriveTick, OvercurrentTurnsThePwmOffInTheSameTick) {
   sim::SimBoard board(test::test_motors()[0].parameters, {});
   DriveConfig config;
-  config.auto_enable = true;              // no enable command on this bench
+  config.auto_enable = true;             // no enable command on this bench
   config.protection.tick_budget_ns = 0;  // wall-clock time on a shared host is not the MCU's
   config.i_max_A = 6.0;
   config.protection.overcurrent_A = 9.0;
@@ -123,8 +123,8 @@ TEST(DriveTick, BusUnderAndOvervoltageTrip) {
     DriveConfig config;
     config.auto_enable = true;
     config.protection.tick_budget_ns = 0;
-  config.auto_enable = true;              // no enable command on this bench
-  config.protection.tick_budget_ns = 0;  // wall-clock time on a shared host is not the MCU's
+    config.auto_enable = true;             // no enable command on this bench
+    config.protection.tick_budget_ns = 0;  // wall-clock time on a shared host is not the MCU's
     config.protection.bus_min_V = 200.0;
     config.protection.bus_max_V = 450.0;
     Rig rig(board_config, config);
@@ -137,7 +137,7 @@ TEST(DriveTick, BusUnderAndOvervoltageTrip) {
 
 TEST(DriveTick, OverrunTrips) {
   DriveConfig config;
-  config.auto_enable = true;              // no enable command on this bench
+  config.auto_enable = true;             // no enable command on this bench
   config.protection.tick_budget_ns = 0;  // wall-clock time on a shared host is not the MCU's
   config.protection.tick_budget_ns = 1;  // no tick runs in 1 ns
   Rig rig({}, config);
@@ -145,6 +145,32 @@ TEST(DriveTick, OverrunTrips) {
   EXPECT_EQ(rig.drive.fault(), FaultCode::overrun);
   EXPECT_FALSE(rig.board.pwm().enabled());
   EXPECT_GE(rig.drive.execution().overruns, 1u);
+}
+
+}  // namespace
+}  // namespace imd::firmware
+
+namespace imd::firmware {
+namespace {
+
+TEST(DriveTick, OverspeedTripsOnTheEstimate) {
+  // The reference climbs at 20 rad/s^2 past a 5 rad/s overspeed limit: the trip comes in the
+  // tick the estimated speed crosses it, with the PWM off.
+  DriveConfig config;
+  config.auto_enable = true;
+  config.protection.tick_budget_ns = 0;
+  config.protection.overspeed_rad_s = 5.0;
+  config.speed_reaching_pole = config.flux_reaching_pole = 0.98;
+  Rig rig({}, config);
+  double last_estimate = 0.0;
+  for (int k = 0; k < 20000 && rig.drive.state() != DriveState::fault; ++k) {
+    last_estimate = rig.drive.record().omega_est_rad_s;
+    rig.board.run_tick();
+  }
+  EXPECT_EQ(rig.drive.fault(), FaultCode::overspeed);
+  EXPECT_FALSE(rig.board.pwm().enabled());
+  EXPECT_LE(last_estimate, 5.0);  // the tick before was within the limit
+  EXPECT_GT(rig.drive.record().omega_est_rad_s, 5.0);
 }
 
 }  // namespace
