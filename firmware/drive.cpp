@@ -18,7 +18,9 @@ bool finite(const control::Vec2<T>& v) noexcept {
 
 /// A duration in whole ticks, rounded up (construction only).
 uint64_t ticks(double duration_s, double period_s) noexcept {
-  return duration_s > 0 ? static_cast<uint64_t>(std::ceil(duration_s / period_s - 1e-9)) : 0;
+  if (!(duration_s > 0)) return 0;
+  const double ticks = std::ceil(duration_s / period_s - 1e-9);
+  return ticks < 1e18 ? static_cast<uint64_t>(ticks) : UINT64_MAX;  // an infinite duration too
 }
 
 }  // namespace
@@ -45,8 +47,8 @@ Drive<T>::Drive(const control::MotorParameters& motor, const DriveConfig& config
       speed_ramp_(config.max_accel_rad_s2, config.sample_period_s),
       iol_stage_(motor, config),
       controller_(config.controller),
-      decoder_(config.node_id,
-               {float(config.protection.overspeed_rad_s), float(config.max_flux2_Wb2)}),
+      decoder_(config.node_id, {float(config.protection.overspeed_rad_s),
+                                float(config.min_flux2_command_Wb2), float(config.max_flux2_Wb2)}),
       telemetry_(config.node_id, peripherals.timer.period_ns(), config.telemetry_rate_Hz),
       encoder_check_({double(peripherals.encoder.counts_per_rev()), config.sample_period_s,
                       motor.J_kgm2, motor.friction_Nms, config.protection.encoder_missing_counts,
@@ -77,6 +79,7 @@ Drive<T>::Drive(const control::MotorParameters& motor, const DriveConfig& config
   if (config_.adc_calibration_ticks <= 0) {
     const auto scale = hw_.adc.scale();
     for (T& offset : offset_code_) offset = T(scale.phase_mid_code);
+    calibrated_ = true;
     machine_.go(DriveState::idle, TransitionReason::calibrated, 0);
     if (config_.auto_enable) enable(0);
   }
@@ -84,8 +87,16 @@ Drive<T>::Drive(const control::MotorParameters& motor, const DriveConfig& config
 }
 
 template <typename T>
-void Drive<T>::trip(FaultCode code, uint64_t k, uint8_t detail) noexcept {
+void Drive<T>::pwm_off() noexcept {
   hw_.pwm.disable();
+  // Neutral duties: a timer that starts from its last duties applies nothing stale on enable.
+  hw_.pwm.set_duties({0.5f, 0.5f, 0.5f});
+}
+
+template <typename T>
+void Drive<T>::trip(FaultCode code, uint64_t k, uint8_t detail) noexcept {
+  pwm_off();
+  commanded_.set_speed(0.0);  // after clear and enable, the host sends a new speed
   status_.fault_bits = static_cast<uint16_t>(status_.fault_bits | (1u << unsigned(code)));
   if (machine_.state() == DriveState::fault) return;  // the first fault is kept
   status_.first_fault = code;
@@ -252,8 +263,8 @@ void Drive<T>::protect(uint64_t k, const Estimate& e, const hal::AdcSample& samp
     trip(FaultCode::non_finite, k);
   }
   const T torque_Nm = modulating() ? electromagnetic_torque_Nm(e.x) : T(0);
-  if (oracle_ == nullptr &&
-      encoder_check_.failed(encoder_delta_counts_, e.x.omega_mech_rad_s, e.load_Nm, torque_Nm)) {
+  if (oracle_ == nullptr && encoder_check_.failed(encoder_delta_counts_, e.x.omega_mech_rad_s,
+                                                  e.load_Nm, torque_Nm, modulating())) {
     trip(FaultCode::encoder, k);
   }
   if (!modulating()) {
@@ -407,7 +418,7 @@ control::Vec2<T> Drive<T>::control(uint64_t k, const Estimate& e, T v_bus_V) noe
   if (stopping && ((speed_ramp_.value() == T(0) &&
                     std::abs(e.x.omega_mech_rad_s) < T(config_.stop_speed_rad_s)) ||
                    k - stop_start_tick_ > stop_timeout_ticks_)) {
-    hw_.pwm.disable();
+    pwm_off();
     machine_.go(DriveState::idle, TransitionReason::stopped, k);
     return Vec2::Zero();
   }
@@ -424,21 +435,28 @@ void Drive<T>::on_tick() noexcept {
 
   const hal::AdcSample sample = hw_.adc.sample();
   receive_commands(k);
+  const T v_bus_V = T(sample.bus_code) * T(hw_.adc.scale().bus_V_per_code);
   if (machine_.state() == DriveState::calibrating) {
+    record_.v_bus_V = double(v_bus_V);
     if (calibrate_adc(sample)) {
+      calibrated_ = true;
       machine_.go(DriveState::idle, TransitionReason::calibrated, k);
       if (config_.auto_enable) enable(k + 1);
     }
+  } else if (!calibrated_) {
+    // A fault before the offsets were known: nothing can be measured; clear_faults
+    // calibrates again.
+    hw_.pwm.disable();
+    record_.v_bus_V = double(v_bus_V);
   } else {
     // --- sense, estimate, check
-    const T v_bus_V = T(sample.bus_code) * T(hw_.adc.scale().bus_V_per_code);
     const Estimate e = estimate(sample);
     protect(k, e, sample, v_bus_V);
     Vec2 v = Vec2::Zero();
     if (modulating()) {
       v = control(k, e, v_bus_V);
     } else {
-      hw_.pwm.disable();
+      if (hw_.pwm.enabled()) pwm_off();
       record_.u_alpha_V = record_.u_beta_V = 0.0;
       u_written_V_ = Vec2::Zero();
       // Telemetry shows what the drive would aim at once enabled.

@@ -106,6 +106,7 @@ class Drive final : public hal::TickHandler {
   Vec2 compensation_AB(const control::RotorFrameState<T>& x) const noexcept;
   /// Turns the PWM off and latches the fault (the first one keeps its code and time).
   void trip(FaultCode code, uint64_t k, uint8_t detail = 0) noexcept;
+  void pwm_off() noexcept;
   bool modulating() const noexcept;
   T electromagnetic_torque_Nm(const control::RotorFrameState<T>& x) const noexcept;
 
@@ -140,6 +141,7 @@ class Drive final : public hal::TickHandler {
   uint64_t stop_start_tick_ = 0, stop_timeout_ticks_ = 0;
   int32_t encoder_delta_counts_ = 0;  ///< counts over the last period
   Vec2 u_written_V_ = Vec2::Zero();   ///< last stator voltage command (alpha-beta)
+  bool calibrated_ = false;  ///< the ADC offsets are known
   int calibration_count_ = 0;
   int64_t calibration_sum_[3] = {0, 0, 0};
   T offset_code_[3] = {T(0), T(0), T(0)};

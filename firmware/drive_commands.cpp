@@ -33,11 +33,18 @@ void Drive<T>::enable(uint64_t k) noexcept {
   speed_ramp_.set_max_accel(config_.max_accel_rad_s2, config_.sample_period_s);
   adc_stuck_check_.reset();
   phase_loss_check_.reset();
+  encoder_check_.reset();
 }
 
 template <typename T>
 void Drive<T>::clear_faults(uint64_t k) noexcept {
-  if (!machine_.go(DriveState::idle, TransitionReason::clear_faults, k)) return;
+  // A fault during the offset calibration leaves the offsets unknown: calibrate again.
+  const DriveState next = calibrated_ ? DriveState::idle : DriveState::calibrating;
+  if (!machine_.go(next, TransitionReason::clear_faults, k)) return;
+  if (!calibrated_) {
+    calibration_count_ = 0;
+    for (int64_t& sum : calibration_sum_) sum = 0;
+  }
   status_.fault_bits = 0;
   status_.first_fault = FaultCode::none;
   status_.fault_detail = 0;
@@ -61,8 +68,9 @@ protocol::CommandResult Drive<T>::apply(const protocol::Command& c, uint64_t k) 
                  ? CommandResult::accepted
                  : CommandResult::not_allowed;
     case CommandKind::disable:
+      commanded_.set_speed(0.0);           // a later enable waits for a new speed
       if (s == DriveState::magnetizing) {  // no motion to stop yet
-        hw_.pwm.disable();
+        pwm_off();
         machine_.go(DriveState::idle, TransitionReason::disable, k);
       } else if (s == DriveState::running) {
         machine_.go(DriveState::stopping, TransitionReason::disable, k);

@@ -73,7 +73,8 @@ struct DriveConfig {
   /// Enable once calibrated, without a command (scenario profiles).
   bool auto_enable = false;
   int telemetry_rate_Hz = 100;  ///< fast telemetry, 10..1000
-  double max_flux2_Wb2 = 4.0;   ///< largest set_flux accepted
+  double min_flux2_command_Wb2 = 0.01;  ///< smallest set_flux accepted (10 x min_flux2_Wb2)
+  double max_flux2_Wb2 = 4.0;           ///< largest set_flux accepted
   /// Initial references over CAN, before any set_speed or set_flux.
   double flux2_ref_Wb2 = 0.2, stator_flux2_ref_Wb2 = 1.0;
 

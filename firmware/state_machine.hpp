@@ -1,7 +1,7 @@
 #pragma once
 /// The drive's state machine:
 ///   calibrating -> idle -> magnetizing -> running -> stopping -> idle
-///   any state -> fault -> idle (only by clear_faults)
+///   any state -> fault -> idle (only by clear_faults; to calibrating if the fault came first)
 /// Every transition is checked against this graph, counted, and kept in a short log that the
 /// telemetry reports as state_change frames. No heap; tick context.
 #include <array>
@@ -48,7 +48,7 @@ class StateMachine {
       case S::stopping:
         return to == S::idle;
       case S::fault:
-        return to == S::idle;
+        return to == S::idle || to == S::calibrating;
     }
     return false;
   }

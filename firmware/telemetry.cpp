@@ -67,7 +67,7 @@ void Telemetry::publish(uint64_t k, hal::CanBus& can, const TickRecord& r,
   if (k % fast_period_ticks_ == 0) {
     send(can, encode_frame(node_id_, MessageId::telemetry_speed_flux,
                            {float(r.omega_est_rad_s), float(r.omega_ref_rad_s),
-                            float(r.flux2_est_Wb2), float(r.flux2_ref_Wb2)}));
+                            float(r.controlled_flux2_Wb2), float(r.controlled_flux2_ref_Wb2)}));
     send(can,
          encode_frame(node_id_, MessageId::telemetry_current,
                       {float(r.i_A_A), float(r.i_B_A), float(r.load_est_Nm), float(r.v_bus_V)}));

@@ -54,6 +54,7 @@ class SimBoard {
   hal::AnalogInnerLoop& analog_inner_loop() noexcept { return analog_; }
   hal::CurrentSource& current_source() noexcept { return current_source_; }
   SimCan& can_side() noexcept { return can_; }
+  const SimPwm& pwm_side() const noexcept { return pwm_; }
 
   InductionMotorPlant& plant() noexcept { return plant_; }
   const InductionMotorPlant& plant() const noexcept { return plant_; }

@@ -1,10 +1,12 @@
 #pragma once
 /// Stuck current ADC: the three phase codes repeat exactly for `stuck_ticks` ticks although the
-/// applied stator voltage changed enough to move the current by more than four codes. Over one
-/// period a voltage change du changes the current by du * period / sigma_H (the leakage
-/// inductance sets di/dt), so a converter that repeats itself against that evidence is stuck.
-/// A motor at rest under a constant voltage (steady magnetizing) gives no evidence and is not
-/// judged: a quiet converter may legitimately repeat its codes then. Tick context.
+/// applied stator voltage departed from its value at the first repeat enough to move the
+/// current by more than four codes. A voltage departure du held for one period moves the
+/// current by du * period / sigma_H (the leakage inductance sets di/dt), so the evidence is the
+/// norm of the summed departures over the window; jitter around a constant voltage cancels in
+/// that sum, and the window restarts every `stuck_ticks`, so it never accumulates. A motor at
+/// rest under a constant voltage (steady magnetizing) gives no evidence and is not judged: a
+/// quiet converter may legitimately repeat its codes then. Tick context.
 #include <array>
 #include <cstdint>
 
@@ -22,33 +24,34 @@ class AdcStuckCheck {
 
   void reset() noexcept {
     same_ticks_ = 0;
-    evidence_A_ = T(0);
     started_ = false;
   }
 
   /// `u_V`: the stator voltage applied over the last period (alpha-beta). True if stuck.
   bool stuck(const std::array<uint16_t, 3>& codes, const control::Vec2<T>& u_V) noexcept {
-    if (started_ && codes == last_codes_) {
-      ++same_ticks_;
-      evidence_A_ += (u_V - last_u_V_).norm() * A_per_V_;
-    } else {
-      same_ticks_ = 0;
-      evidence_A_ = T(0);
-    }
+    const bool repeated = started_ && codes == last_codes_;
     started_ = true;
     last_codes_ = codes;
-    last_u_V_ = u_V;
-    return same_ticks_ >= stuck_ticks_ && evidence_A_ > evidence_needed_A_;
+    if (repeated) {
+      ++same_ticks_;
+      departure_sum_V_ += u_V - u_first_V_;
+      if (same_ticks_ < stuck_ticks_) return false;
+      if (departure_sum_V_.norm() * A_per_V_ > evidence_needed_A_) return true;
+    }
+    same_ticks_ = 0;  // a new window from here
+    u_first_V_ = u_V;
+    departure_sum_V_ = control::Vec2<T>::Zero();
+    return false;
   }
 
  private:
   int stuck_ticks_;
   T A_per_V_, evidence_needed_A_;
   int same_ticks_ = 0;
-  T evidence_A_ = T(0);
   bool started_ = false;
   std::array<uint16_t, 3> last_codes_{};
-  control::Vec2<T> last_u_V_ = control::Vec2<T>::Zero();
+  control::Vec2<T> u_first_V_ = control::Vec2<T>::Zero();
+  control::Vec2<T> departure_sum_V_ = control::Vec2<T>::Zero();
 };
 
 }  // namespace imd::firmware

@@ -13,6 +13,14 @@
 
 namespace imd::firmware {
 
+/// The largest plausible count step: 1.5 x the overspeed limit over one period, plus 2 counts
+/// for the latching instant (no limit for an infinite overspeed).
+inline int32_t max_jump(double overspeed_rad_s, double period_s, double counts_per_rev) noexcept {
+  const double counts =
+      1.5 * overspeed_rad_s * period_s * counts_per_rev / (2.0 * std::numbers::pi);
+  return counts < 1e9 ? static_cast<int32_t>(std::ceil(counts)) + 2 : INT32_MAX;
+}
+
 template <typename T>
 class EncoderCheck {
  public:
@@ -40,13 +48,22 @@ class EncoderCheck {
   }
 
   /// Forget the history (after the encoder was (re)started or a fault was cleared).
-  void reset() noexcept { silent_ticks_ = window_ticks_; }
+  void reset() noexcept {
+    silent_ticks_ = window_ticks_;
+    travel_rad_ = omega_rad_s_ = T(0);
+  }
 
   /// One tick: the counts seen over the last period, and the drive's estimates now.
-  /// `torque_Nm` is the electromagnetic torque over the coming period. True if the encoder has
-  /// failed.
-  bool failed(int32_t delta_counts, T omega_est_rad_s, T load_est_Nm, T torque_Nm) noexcept {
+  /// `torque_Nm` is the electromagnetic torque over the coming period. With the PWM off
+  /// (`driving` false) the load is unknown (a braked or held rotor), so only jumps are judged
+  /// and the model restarts when the drive does. True if the encoder has failed.
+  bool failed(int32_t delta_counts, T omega_est_rad_s, T load_est_Nm, T torque_Nm,
+              bool driving = true) noexcept {
     if (delta_counts > max_jump_counts_ || delta_counts < -max_jump_counts_) return true;
+    if (!driving) {
+      reset();
+      return false;
+    }
     // The model predicted `travel_rad_` over the silence so far.
     if (delta_counts == 0 && std::abs(travel_rad_) > missing_rad_) return true;
     if (delta_counts != 0 || silent_ticks_ >= window_ticks_) {  // anchor to the estimate

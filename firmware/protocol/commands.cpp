@@ -62,11 +62,17 @@ Decoded CommandDecoder::decode(const hal::CanFrame& frame) noexcept {
   if (frame.data[0] != e2e_crc(frame.id, frame.data, frame.length)) {
     return reject(d, CommandResult::bad_crc);
   }
-  if (have_counter_) {
+  // The emergency stop is obeyed whatever its counter: stopping twice is harmless, and a host
+  // whose counter went out of step must still be able to stop the motor.
+  if (have_counter_ && m->id != MessageId::emergency_stop) {
     const uint8_t step = static_cast<uint8_t>((d.counter - last_counter_) & 0x0F);
     if (step == 0) return reject(d, CommandResult::repeated_counter);
     if (step > kMaxCounterStep) return reject(d, CommandResult::stale_counter);
   }
+  // The frame passed the E2E checks: its counter is the new reference, as the host's counter
+  // moved on, even if the value below is refused.
+  have_counter_ = true;
+  last_counter_ = d.counter;
   Command& c = d.command;
   switch (m->id) {
     case MessageId::emergency_stop:
@@ -91,7 +97,7 @@ Decoded CommandDecoder::decode(const hal::CanFrame& frame) noexcept {
     case MessageId::set_flux:
       c.kind = CommandKind::set_flux;
       c.value = get_physical(frame.data, payload_signal(MessageId::set_flux));
-      if (!(c.value > 0.0f && c.value <= limits_.max_flux2_Wb2)) {
+      if (!(c.value >= limits_.min_flux2_Wb2 && c.value <= limits_.max_flux2_Wb2)) {
         return reject(d, CommandResult::out_of_range);
       }
       break;
@@ -112,8 +118,6 @@ Decoded CommandDecoder::decode(const hal::CanFrame& frame) noexcept {
   }
   // Reserved bits must be zero, so that a future field is never misread as this one.
   if ((frame.data[1] & 0xF0) != 0) return reject(d, CommandResult::out_of_range);
-  have_counter_ = true;
-  last_counter_ = d.counter;
   d.result = CommandResult::accepted;
   return d;
 }

@@ -3,10 +3,12 @@
 /// the encoder hosts use (drive_monitor, the simulator's scripted commands).
 ///
 /// A frame is rejected, counted and reported (and changes nothing) when its length is not the
-/// message's, its CRC is wrong, its alive counter repeats the last accepted one or jumps by more
-/// than kMaxCounterStep (a stale or replayed frame), or a value is out of range. The first frame
-/// after start-up sets the counter reference. One counter covers all commands of a node, so a
-/// host that starts late learns where it stands from the heartbeat's command_counter.
+/// message's, its CRC is wrong, its alive counter repeats the last one or jumps by more than
+/// kMaxCounterStep (a stale or replayed frame), or a value is out of range. A frame that passes
+/// the length, CRC and counter checks sets the counter reference even if its value is refused,
+/// because the host's counter moved on; the first frame after start-up sets it too. The
+/// emergency stop skips the counter check. One counter covers all commands of a node, so a host
+/// that starts late learns where it stands from the heartbeat's command_counter.
 #include <array>
 #include <cstdint>
 
@@ -50,7 +52,8 @@ inline constexpr uint8_t kMaxCounterStep = 3;
 /// The ranges the decoder enforces; the application sets them from its configuration.
 struct CommandLimits {
   float max_speed_rad_s = 400.0f;  ///< |set_speed| <= this (the overspeed threshold)
-  float max_flux2_Wb2 = 4.0f;      ///< 0 < set_flux <= this
+  float min_flux2_Wb2 = 0.01f;     ///< set_flux >= this (well away from a singular B_k)
+  float max_flux2_Wb2 = 4.0f;      ///< set_flux <= this
 };
 
 struct Decoded {

@@ -140,6 +140,44 @@ TEST(DriveCommands, EmergencyStopLatchesUntilCleared) {
   EXPECT_EQ(rig.drive.status().fault_bits, 0);
 }
 
+TEST(DriveCommands, AFaultDuringCalibrationCalibratesAgainWhenCleared) {
+  CanRig rig;
+  rig.run(10);  // 10 of the 256 calibration ticks
+  rig.send({CommandKind::emergency_stop});
+  rig.run(5);
+  ASSERT_EQ(rig.drive.fault(), FaultCode::emergency_stop);
+  EXPECT_EQ(rig.drive.status().fault_bits, 1u << unsigned(FaultCode::emergency_stop));
+  rig.send({CommandKind::clear_faults});
+  rig.run(1);
+  EXPECT_EQ(rig.drive.state(), DriveState::calibrating);  // the offsets were never measured
+  rig.run(300);
+  EXPECT_EQ(rig.drive.state(), DriveState::idle);
+  EXPECT_EQ(rig.drive.fault(), FaultCode::none);
+}
+
+TEST(DriveCommands, AfterATripTheDutiesAreNeutralAndTheSpeedReferenceIsZero) {
+  CanRig rig;
+  rig.run(300);
+  rig.send({CommandKind::set_speed, 30.0f});
+  rig.send({CommandKind::enable});
+  for (int n = 0; n < 10; ++n) {
+    rig.run(500);
+    rig.send({CommandKind::set_speed, 30.0f});
+  }
+  ASSERT_EQ(rig.drive.state(), DriveState::running);
+  rig.send({CommandKind::emergency_stop});
+  rig.run(1);
+  // A timer that starts from its last duties must apply zero voltage on the next enable.
+  for (const float duty : rig.board.pwm_side().written()) EXPECT_EQ(duty, 0.5f);
+  rig.send({CommandKind::clear_faults});
+  for (int n = 0; n < 6; ++n) {  // enable, repeated as a keep-alive: no new set_speed
+    rig.send({CommandKind::enable});
+    rig.run(500);
+  }
+  ASSERT_EQ(rig.drive.state(), DriveState::running) << fault_name(rig.drive.fault());
+  EXPECT_EQ(rig.drive.record().omega_ref_rad_s, 0.0);  // not the 30 rad/s from before
+}
+
 TEST(DriveCommands, TheWatchdogTripsWhenCommandsStop) {
   CanRig rig;
   rig.run(300);

@@ -122,34 +122,65 @@ TEST(EncoderCheck, AnImplausibleJumpFails) {
 }
 
 TEST(AdcStuckCheck, RepeatedCodesWithAMovingVoltageAreStuck) {
-  // 1 A per code, sigma_H = 0.0259 H (paper motor), 1e-4 s: 1 V of change moves 3.861 mA, so
-  // 4 codes need 1036 V of accumulated change.
-  AdcStuckCheck<double> check(20, 1e-4, 0.0259, 1.0);
+  // A 12-bit converter over +-10 A (4.9 mA per code), sigma_H = 0.0259 H (paper motor), 1e-4 s:
+  // a departure of 1 V held for one period moves the current by 3.861 mA, so four codes need
+  // 5.1 V-periods. A 150 V vector turning by 0.05 rad per tick departs from its first value by
+  // |sum_k 150 (e^{0.05ik} - 1)| = 1530 V-periods over 20 ticks: stuck at the end of the first
+  // window, on the 21st sample (the first one is the reference).
+  AdcStuckCheck<double> check(20, 1e-4, 0.0259, 10.0 / 2048);
   const std::array<uint16_t, 3> codes{2048, 2000, 2100};
   int k = 0;
-  double angle = 0.0;
   bool stuck = false;
-  for (; k < 200 && !stuck; ++k, angle += 0.05) {
+  for (double angle = 0.0; k < 200 && !stuck; ++k, angle += 0.05) {
     stuck = check.stuck(codes, {150.0 * std::cos(angle), 150.0 * std::sin(angle)});
   }
   EXPECT_TRUE(stuck);
-  // 150 V turning by 0.05 rad per tick changes by 2 * 150 * sin(0.025) = 7.4996 V per tick:
-  // 1036 V take 139 ticks after the first sample, so the 140th call finds it stuck.
-  EXPECT_EQ(k, 140);
+  EXPECT_EQ(k, 21);
 }
 
 TEST(AdcStuckCheck, AQuietConverterAtAConstantVoltageIsNot) {
-  AdcStuckCheck<double> check(20, 1e-4, 0.0259, 0.005);
+  AdcStuckCheck<double> check(20, 1e-4, 0.0259, 10.0 / 2048);
   const std::array<uint16_t, 3> codes{2048, 2000, 2100};
   for (int k = 0; k < 10000; ++k) ASSERT_FALSE(check.stuck(codes, {40.0, 0.0}));
 }
 
+TEST(AdcStuckCheck, VoltageJitterIsNotEvidence) {
+  // +-0.05 V of jitter around 40 V: within a 20-tick window the departures sum to at most
+  // 20 x 0.1 V = 2 V-periods = 7.7 mA, under the 19.5 mA of four codes, whatever the pattern.
+  AdcStuckCheck<double> check(20, 1e-4, 0.0259, 10.0 / 2048);
+  const std::array<uint16_t, 3> codes{2048, 2000, 2100};
+  uint32_t lcg = 12345;
+  for (int k = 0; k < 100000; ++k) {
+    lcg = lcg * 1664525u + 1013904223u;
+    const double jitter_V = (lcg >> 31) != 0 ? 0.05 : -0.05;
+    ASSERT_FALSE(check.stuck(codes, {40.0 + jitter_V, jitter_V})) << k;
+  }
+}
+
 TEST(AdcStuckCheck, ChangingCodesAreNotStuck) {
-  AdcStuckCheck<double> check(20, 1e-4, 0.0259, 0.005);
+  AdcStuckCheck<double> check(20, 1e-4, 0.0259, 10.0 / 2048);
   for (int k = 0; k < 10000; ++k) {
     const std::array<uint16_t, 3> codes{uint16_t(2048 + k % 2), 2000, 2100};
     ASSERT_FALSE(check.stuck(codes, {150.0 * std::cos(k), 150.0 * std::sin(k)}));
   }
+}
+
+TEST(EncoderCheck, ClearsAfterAResetAtRest) {
+  // A trip at speed, then the rotor at rest: after reset() (clear_faults) a silent encoder is
+  // judged afresh, not on the stale prediction.
+  EncoderCheck<double> check(encoder_config());
+  EXPECT_FALSE(check.failed(13, 100.0, 0.0, 0.0));
+  ASSERT_TRUE(check.failed(0, 100.0, 0.0, 0.0));
+  check.reset();
+  for (int k = 0; k < 1000; ++k) ASSERT_FALSE(check.failed(0, 0.0, 0.0, 0.0)) << k;
+}
+
+TEST(EncoderCheck, WithThePwmOffOnlyJumpsCount) {
+  // Stopped against friction the load estimate stays at 1 N m with no torque applied: the
+  // model would predict a reverse acceleration. With the PWM off it is not run.
+  EncoderCheck<double> check(encoder_config());
+  for (int k = 0; k < 10000; ++k) ASSERT_FALSE(check.failed(0, 0.0, 1.0, 0.0, false)) << k;
+  EXPECT_TRUE(check.failed(100, 0.0, 1.0, 0.0, false));
 }
 
 /// Phase currents of amplitude 5 A at the flux angle plus a load angle.

@@ -63,7 +63,7 @@ TEST(SignalPacking, NodeAndMessageFormTheIdentifier) {
 
 class Decoder : public ::testing::Test {
  protected:
-  CommandDecoder decoder{1, CommandLimits{100.0f, 1.0f}};
+  CommandDecoder decoder{1, CommandLimits{100.0f, 0.01f, 1.0f}};
   CommandEncoder encoder{1};
 };
 
@@ -132,8 +132,8 @@ TEST_F(Decoder, RejectsAWrongLength) {
 TEST_F(Decoder, RejectsOutOfRangeValues) {
   EXPECT_EQ(decoder.decode(encoder.encode({CommandKind::set_speed, 100.5f})).result,
             CommandResult::out_of_range);
-  EXPECT_EQ(decoder.decode(encoder.encode({CommandKind::set_flux, 0.0f})).result,
-            CommandResult::out_of_range);
+  EXPECT_EQ(decoder.decode(encoder.encode({CommandKind::set_flux, 0.005f})).result,
+            CommandResult::out_of_range);  // below the 0.01 Wb^2 floor
   EXPECT_EQ(decoder.decode(encoder.encode({CommandKind::set_flux, 1.5f})).result,
             CommandResult::out_of_range);
   EXPECT_EQ(decoder.decode(encoder.encode({CommandKind::select_controller, 2.0f})).result,
@@ -143,9 +143,27 @@ TEST_F(Decoder, RejectsOutOfRangeValues) {
   EXPECT_EQ(decoder.decode(encoder.encode({CommandKind::set_telemetry_rate, 1001.0f})).result,
             CommandResult::out_of_range);
   EXPECT_EQ(decoder.rejected(CommandResult::out_of_range), 6u);
-  // The counter never advanced, so the next valid frame may step from anywhere.
+  // Each refused frame passed the E2E checks, so the reference followed the host's counter:
+  // the next frame in sequence is accepted, and the last refused counter cannot be replayed.
+  EXPECT_EQ(decoder.last_counter(), 5);  // the sixth frame carried counter 5
   EXPECT_EQ(decoder.decode(encoder.encode({CommandKind::set_flux, 0.5f})).result,
             CommandResult::accepted);
+}
+
+TEST_F(Decoder, EmergencyStopIgnoresTheCounter) {
+  EXPECT_EQ(decoder.decode(encoder.encode({CommandKind::enable})).result, CommandResult::accepted);
+  encoder.set_next_counter(9);  // out of step: every other command is refused...
+  EXPECT_EQ(decoder.decode(encoder.encode({CommandKind::disable})).result,
+            CommandResult::stale_counter);
+  encoder.set_next_counter(9);  // ...but a stop is obeyed, even repeated
+  EXPECT_EQ(decoder.decode(encoder.encode({CommandKind::emergency_stop})).result,
+            CommandResult::accepted);
+  encoder.set_next_counter(9);
+  EXPECT_EQ(decoder.decode(encoder.encode({CommandKind::emergency_stop})).result,
+            CommandResult::accepted);
+  hal::CanFrame corrupt = encoder.encode({CommandKind::emergency_stop});
+  corrupt.data[0] ^= 0x01;  // but never with a bad CRC
+  EXPECT_EQ(decoder.decode(corrupt).result, CommandResult::bad_crc);
 }
 
 TEST_F(Decoder, RejectsReservedBitsAndUnknownMessages) {

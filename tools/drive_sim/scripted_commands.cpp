@@ -75,10 +75,15 @@ std::vector<ScriptedFrame> scripted_frames(const Scenario& s) {
   for (const CanCommandScript& c : s.can_commands) {
     const protocol::Message& m = find_command(s, c);
     const double end_s = std::min(c.until_s, s.duration_s);
-    for (double t = c.at_s; t <= end_s; t += c.every_s) {
-      pending.push_back({t, &c, &m});
-      if (!(c.every_s > 0)) break;
+    // Repeats at at_s + n every_s (no accumulated rounding), at most one per tick.
+    const double count = c.every_s > 0 ? std::floor((end_s - c.at_s) / c.every_s + 1e-9) : 0.0;
+    if (c.every_s > 0 && c.every_s < s.sample_period_s) {
+      throw ConfigError(
+          fmt::format("{}: can_commands[{}].every_s = {}: shorter than the sample "
+                      "period ({} s)",
+                      s.source, c.index, c.every_s, s.sample_period_s));
     }
+    for (double n = 0; n <= count; ++n) pending.push_back({c.at_s + n * c.every_s, &c, &m});
   }
   std::stable_sort(pending.begin(), pending.end(),
                    [](const Pending& a, const Pending& b) { return a.t_s < b.t_s; });
