@@ -32,6 +32,11 @@ std::deque<hal::CanFrame> SimCan::take_sent() {
   return std::exchange(sent_, {});
 }
 
+void SimCan::take_sent(std::vector<hal::CanFrame>& out) {
+  out.assign(sent_.begin(), sent_.end());
+  sent_.clear();
+}
+
 uint64_t SimTimer::execution_clock_ns() const noexcept {
   const auto host_ns =
       static_cast<uint64_t>(std::chrono::duration_cast<std::chrono::nanoseconds>(

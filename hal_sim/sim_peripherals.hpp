@@ -3,6 +3,7 @@
 /// board (SimBoard) updates in lock-step. They hold no physics of their own.
 #include <cstdint>
 #include <deque>
+#include <vector>
 
 #include "hal/analog_inner_loop.hpp"
 #include "hal/can_bus.hpp"
@@ -67,6 +68,8 @@ class SimCan final : public hal::CanBus {
   bool inject(const hal::CanFrame& frame);
   /// Simulation side: take the frames the firmware sent since the last call.
   std::deque<hal::CanFrame> take_sent();
+  /// The same, into `out` (cleared first): no allocation once `out` has grown.
+  void take_sent(std::vector<hal::CanFrame>& out);
 
   /// Fault: from now on every injected frame is lost (the host side falls silent). Frames
   /// already received stay; the firmware's sent frames are still collected.

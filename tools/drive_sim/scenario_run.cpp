@@ -153,6 +153,7 @@ Summary run(const Scenario& s, const RunCallbacks& callbacks) {
     double torque_ref_Nm = 0.0, y2 = 0.0, y2_ref = 0.0;
   } held;  // iol values of the last boundary, held until the next
   uint64_t measured = 0, saturated = 0;
+  std::vector<hal::CanFrame> sent_frames;  // reused: no allocation per tick
   uint16_t last_fault_bits = 0;
   bool diverged = false;
   for (uint64_t k = 0; k < ticks; ++k) {
@@ -179,8 +180,9 @@ Summary run(const Scenario& s, const RunCallbacks& callbacks) {
     const double load_Nm = board.load_Nm();
     board.run_tick();
     const firmware::TickRecord& rec = drive.record();
-    for (const hal::CanFrame& frame : board.can_side().take_sent()) {
-      if (callbacks.can_frame) callbacks.can_frame(t_s, frame);
+    board.can_side().take_sent(sent_frames);
+    if (callbacks.can_frame) {
+      for (const hal::CanFrame& frame : sent_frames) callbacks.can_frame(t_s, frame);
     }
 
     SimRow row;
