@@ -494,6 +494,7 @@ void Drive<T>::on_tick() noexcept {
   if (budget_ns > 0 && record_.exec_ns > budget_ns) {
     ++execution_.overruns;
     trip(FaultCode::overrun, k);  // the PWM is off before the next period starts
+    v_in_flight_V_ = Vec2::Zero();  // so this tick's voltage never acts
   }
   status_.state = machine_.state();
   status_.command_counter = decoder_.last_counter();
