@@ -1,6 +1,7 @@
 #!/bin/sh
 # Installs the Debian 12 packages the build and the tests need (with --plot, those the main
-# job's plots need; with --cortex-m, the bare-metal Cortex-M4F toolchain) if any is missing.
+# job's plots need; with --cortex-m, the bare-metal Cortex-M4F toolchain; with --fuzz, clang and
+# its libFuzzer runtime) if any is missing.
 # Idempotent: when everything is present it changes nothing and needs no network.
 set -eu
 packages="g++ cmake ninja-build libeigen3-dev libtomlplusplus-dev libcli11-dev nlohmann-json3-dev
@@ -9,7 +10,8 @@ for option in "$@"; do
   case "$option" in
     --plot) packages="$packages python3 python3-numpy python3-matplotlib" ;;
     --cortex-m) packages="$packages gcc-arm-none-eabi libnewlib-arm-none-eabi libstdc++-arm-none-eabi-newlib" ;;
-    *) echo "install_deps: unknown option $option (known: --plot, --cortex-m)" >&2; exit 2 ;;
+    --fuzz) packages="$packages clang-14 libclang-rt-14-dev" ;;
+    *) echo "install_deps: unknown option $option (known: --plot, --cortex-m, --fuzz)" >&2; exit 2 ;;
   esac
 done
 

@@ -11,20 +11,8 @@ esac
 root=$(cd "$(dirname "$0")/.." && pwd)
 cd "$root"
 
-# clang and its libFuzzer/sanitizer runtimes, installed if missing (as tools/install_deps.sh).
-missing=""
-for package in clang-14 libclang-rt-14-dev; do
-  if ! dpkg-query -W -f='${Status}' "$package" 2>/dev/null | grep -q "install ok installed"; then
-    missing="$missing $package"
-  fi
-done
-if [ -n "$missing" ]; then
-  echo "run_fuzzers: installing$missing"
-  if [ "$(id -u)" -eq 0 ]; then sudo=""; else sudo="sudo"; fi
-  $sudo apt-get update -qq
-  $sudo env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends $missing
-fi
-"$root/tools/install_deps.sh"
+# clang and its libFuzzer/sanitizer runtimes with the rest, installed if missing.
+"$root/tools/install_deps.sh" --fuzz
 
 cmake --preset fuzz >/dev/null
 cmake --build --preset fuzz

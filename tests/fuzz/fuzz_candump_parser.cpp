@@ -8,19 +8,12 @@
 #include <cstdlib>
 #include <string_view>
 
+#include "fuzz_check.hpp"
 #include "tools/can_log/candump_log.hpp"
 #include "tools/drive_monitor/monitor.hpp"
 #include "tools/drive_monitor/status_table.hpp"
 
 namespace {
-
-#define FUZZ_CHECK(condition)                                                         \
-  do {                                                                                \
-    if (!(condition)) {                                                               \
-      std::fprintf(stderr, "invariant failed: %s (line %d)\n", #condition, __LINE__); \
-      std::abort();                                                                   \
-    }                                                                                 \
-  } while (0)
 
 /// Beyond 2^50 us (~36 years) the writer's double time_s no longer holds every microsecond.
 constexpr int64_t kExactTime_us = int64_t(1) << 50;

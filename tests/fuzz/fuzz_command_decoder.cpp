@@ -14,20 +14,13 @@
 
 #include "firmware/protocol/commands.hpp"
 #include "firmware/protocol/e2e.hpp"
+#include "fuzz_check.hpp"
 
 namespace {
 
 namespace protocol = imd::firmware::protocol;
 using protocol::CommandKind;
 using protocol::CommandResult;
-
-#define FUZZ_CHECK(condition)                                                         \
-  do {                                                                                \
-    if (!(condition)) {                                                               \
-      std::fprintf(stderr, "invariant failed: %s (line %d)\n", #condition, __LINE__); \
-      std::abort();                                                                   \
-    }                                                                                 \
-  } while (0)
 
 struct Config {
   uint8_t node_id;
