@@ -94,6 +94,17 @@ void Drive<T>::pwm_off() noexcept {
 }
 
 template <typename T>
+void Drive<T>::write_line(int line, bool level) noexcept {
+  if (hw_.gpio != nullptr && line >= 0) hw_.gpio->write(static_cast<uint8_t>(line), level);
+}
+
+template <typename T>
+bool Drive<T>::enable_input_active() const noexcept {
+  const int line = config_.enable_input_line;
+  return hw_.gpio == nullptr || line < 0 || hw_.gpio->read(static_cast<uint8_t>(line));
+}
+
+template <typename T>
 void Drive<T>::trip(FaultCode code, uint64_t k, uint8_t detail) noexcept {
   pwm_off();
   commanded_.set_speed(0.0);  // after clear and enable, the host sends a new speed
@@ -428,13 +439,16 @@ control::Vec2<T> Drive<T>::control(uint64_t k, const Estimate& e, T v_bus_V) noe
 template <typename T>
 void Drive<T>::on_tick() noexcept {
   const uint64_t start_ns = hw_.timer.execution_clock_ns();
+  write_line(config_.timing_output_line, true);
   const uint64_t k = hw_.timer.tick_count();
   record_.tick = k;
   record_.speed_saturated = record_.flux_saturated = record_.voltage_clipped = false;
   record_.iol_boundary = false;
 
   const hal::AdcSample sample = hw_.adc.sample();
+  enable_input_ = enable_input_active();  // before the commands: enable needs it
   receive_commands(k);
+  if (!enable_input_ && modulating()) trip(FaultCode::enable_input, k);
   const T v_bus_V = T(sample.bus_code) * T(hw_.adc.scale().bus_V_per_code);
   if (machine_.state() == DriveState::calibrating) {
     record_.v_bus_V = double(v_bus_V);
@@ -503,8 +517,25 @@ void Drive<T>::on_tick() noexcept {
   record_.fault = status_.first_fault;
   record_.fault_bits = status_.fault_bits;
   if (hw_.can != nullptr) {
+    status_.can_bus_off = hw_.can->bus_off();
     telemetry_.publish(k, *hw_.can, record_, status_, machine_, execution_, budget_ns);
   }
+  const bool faulted = status_.state == DriveState::fault;
+  if (faulted != fault_line_level_) {
+    write_line(config_.fault_output_line, faulted);  // on change only: a system call on Linux
+    fault_line_level_ = faulted;
+  }
+  write_line(config_.timing_output_line, false);
+}
+
+template <typename T>
+void Drive<T>::shut_down(uint64_t k) noexcept {
+  pwm_off();
+  if (modulating()) machine_.go(DriveState::idle, TransitionReason::shutdown, k);
+  status_.state = machine_.state();
+  record_.state = status_.state;
+  if (hw_.can != nullptr) telemetry_.final_heartbeat(*hw_.can, status_, machine_);
+  write_line(config_.timing_output_line, false);
 }
 
 template class Drive<float>;

@@ -39,6 +39,7 @@
 #include "hal/current_adc.hpp"
 #include "hal/current_source.hpp"
 #include "hal/encoder.hpp"
+#include "hal/gpio.hpp"
 #include "hal/pwm.hpp"
 
 namespace imd::firmware {
@@ -51,6 +52,7 @@ struct DrivePeripherals {
   hal::AnalogInnerLoop* analog_inner_loop = nullptr;  ///< only with config.analog_inner_loop
   hal::CurrentSource* current_source = nullptr;       ///< only with config.current_source
   hal::CanBus* can = nullptr;  ///< commands and telemetry; without it the drive is local only
+  hal::Gpio* gpio = nullptr;   ///< the lines DriveConfig names (enable, fault, timing)
 };
 
 template <typename T>
@@ -63,6 +65,10 @@ class Drive final : public hal::TickHandler {
         const StateOracle* oracle = nullptr);
 
   void on_tick() noexcept override;
+  /// For a program that stops the drive (Linux: Ctrl-C, SIGTERM), after the last tick: turns the
+  /// PWM off, goes to idle if modulating (reason shutdown; the motor coasts), and sends a final
+  /// heartbeat. `k` is the tick count at the stop.
+  void shut_down(uint64_t k) noexcept;
 
   DriveState state() const noexcept { return machine_.state(); }
   /// The first latched fault (none when not faulted).
@@ -107,6 +113,10 @@ class Drive final : public hal::TickHandler {
   /// Turns the PWM off and latches the fault (the first one keeps its code and time).
   void trip(FaultCode code, uint64_t k, uint8_t detail = 0) noexcept;
   void pwm_off() noexcept;
+  /// Drives one of the board's output lines (nothing when the line is not wired).
+  void write_line(int line, bool level) noexcept;
+  /// The hardware enable input; true when the board has none.
+  bool enable_input_active() const noexcept;
   bool modulating() const noexcept;
   T electromagnetic_torque_Nm(const control::RotorFrameState<T>& x) const noexcept;
 
@@ -142,6 +152,8 @@ class Drive final : public hal::TickHandler {
   int32_t encoder_delta_counts_ = 0;  ///< counts over the last period
   Vec2 u_written_V_ = Vec2::Zero();   ///< last stator voltage command (alpha-beta)
   bool calibrated_ = false;  ///< the ADC offsets are known
+  bool enable_input_ = true;  ///< the hardware enable input, read at the start of the tick
+  bool fault_line_level_ = false;
   int calibration_count_ = 0;
   int64_t calibration_sum_[3] = {0, 0, 0};
   T offset_code_[3] = {T(0), T(0), T(0)};

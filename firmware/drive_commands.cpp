@@ -63,6 +63,7 @@ protocol::CommandResult Drive<T>::apply(const protocol::Command& c, uint64_t k) 
       trip(FaultCode::emergency_stop, k);
       return CommandResult::accepted;
     case CommandKind::enable:
+      if (!enable_input_) return CommandResult::not_allowed;  // the board's interlock is open
       if (s == DriveState::idle) enable(k);
       return s == DriveState::idle || s == DriveState::magnetizing || s == DriveState::running
                  ? CommandResult::accepted

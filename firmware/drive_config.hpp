@@ -78,6 +78,13 @@ struct DriveConfig {
   /// Initial references over CAN, before any set_speed or set_flux.
   double flux2_ref_Wb2 = 0.2, stator_flux2_ref_Wb2 = 1.0;
 
+  // Board lines: indices into DrivePeripherals::gpio, -1 where the board has none.
+  /// Hardware enable input (safe-torque-off style interlock): while it is inactive the drive
+  /// refuses enable, and losing it while the PWM is on trips fault enable_input.
+  int enable_input_line = -1;
+  int fault_output_line = -1;   ///< active while a fault is latched
+  int timing_output_line = -1;  ///< active while the tick computes (to watch on a scope)
+
   // Disable: ramp to a stop, then PWM off.
   double stop_decel_rad_s2 = 200.0;
   double stop_speed_rad_s = 1.0;  ///< PWM off once the ramp is at 0 and |speed| below this

@@ -34,8 +34,9 @@ enum class FaultCode : uint8_t {
   phase_loss,       ///< one phase carries no current over an electrical revolution
   command_timeout,  ///< no valid command frame within the watchdog timeout while enabled
   emergency_stop,   ///< the emergency-stop command
+  enable_input,     ///< the hardware enable input went inactive while the PWM was on
 };
-inline constexpr int kFaultCodeCount = 15;
+inline constexpr int kFaultCodeCount = 16;
 
 /// Why the state changed (the state_change frame's reason).
 enum class TransitionReason : uint8_t {
@@ -46,6 +47,7 @@ enum class TransitionReason : uint8_t {
   stopped,
   fault,
   clear_faults,
+  shutdown,  ///< the program running the drive is ending (Linux host-in-the-loop)
 };
 
 namespace detail {

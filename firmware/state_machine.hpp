@@ -2,6 +2,7 @@
 /// The drive's state machine:
 ///   calibrating -> idle -> magnetizing -> running -> stopping -> idle
 ///   any state -> fault -> idle (only by clear_faults; to calibrating if the fault came first)
+///   magnetizing, running or stopping -> idle by shutdown only (the program ends, PWM off)
 /// Every transition is checked against this graph, counted, and kept in a short log that the
 /// telemetry reports as state_change frames. No heap; tick context.
 #include <array>
@@ -25,7 +26,7 @@ class StateMachine {
 
   /// Moves to `to` if the graph allows it; false (and nothing changes) otherwise.
   bool go(DriveState to, TransitionReason reason, uint64_t tick) noexcept {
-    if (!allowed(state_, to)) return false;
+    if (!allowed(state_, to, reason)) return false;
     log_[count_ % kLogDepth] = {tick, state_, to, reason};
     ++count_;
     ++entered_[static_cast<int>(to)];
@@ -33,8 +34,12 @@ class StateMachine {
     return true;
   }
 
-  static constexpr bool allowed(DriveState from, DriveState to) noexcept {
+  static constexpr bool allowed(DriveState from, DriveState to,
+                                TransitionReason reason) noexcept {
     using S = DriveState;
+    if (reason == TransitionReason::shutdown) {
+      return to == S::idle && (from == S::magnetizing || from == S::running || from == S::stopping);
+    }
     if (to == S::fault) return from != S::fault;
     switch (from) {
       case S::calibrating:

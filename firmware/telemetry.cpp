@@ -38,26 +38,8 @@ void Telemetry::send(hal::CanBus& can, const hal::CanFrame& frame) noexcept {
 void Telemetry::publish(uint64_t k, hal::CanBus& can, const TickRecord& r,
                         const DriveStatus& status, const StateMachine& machine,
                         const ExecutionStats& execution, uint32_t budget_ns) noexcept {
-  Transition t;
-  while (transitions_sent_ < machine.count()) {
-    if (machine.logged(transitions_sent_, t)) {
-      hal::CanFrame frame = encode_frame(
-          node_id_, MessageId::state_change,
-          {float(t.from), float(t.to), float(t.reason), float((transitions_sent_ + 1) & 0xFF)});
-      // Whole milliseconds exceed a float's 24-bit mantissa after 4.6 h: set the raw bits.
-      protocol::set_raw(frame.data, protocol::kStateChangeSignals[4], time_ms(t.tick));
-      send(can, frame);
-    }
-    ++transitions_sent_;  // a transition that fell out of the log is skipped
-  }
-  if (k % ticks_per_10Hz_ == 0) {
-    send(can,
-         encode_frame(node_id_, MessageId::heartbeat,
-                      {float(status.state), float(status.fault_bits), float(status.first_fault),
-                       float(heartbeat_count_++), float(status.command_counter),
-                       float(status.controller), status.can_bus_off ? 1.0f : 0.0f,
-                       float(status.rejected_commands & 0xFF), float(machine.count() & 0xFF)}));
-  }
+  send_state_changes(can, machine);
+  if (k % ticks_per_10Hz_ == 0) send_heartbeat(can, status, machine);
   if (k % ticks_per_10Hz_ == ticks_per_10Hz_ / 2) {  // between heartbeats, to spread the load
     send(can, encode_frame(node_id_, MessageId::timing,
                            {float(execution.mean_ns() * 1e-3), float(execution.max_ns) * 1e-3f,
@@ -74,6 +56,36 @@ void Telemetry::publish(uint64_t k, hal::CanBus& can, const TickRecord& r,
     send(can, encode_frame(node_id_, MessageId::telemetry_voltage,
                            {float(r.u_alpha_V), float(r.u_beta_V), float(sample_count_++)}));
   }
+}
+
+void Telemetry::final_heartbeat(hal::CanBus& can, const DriveStatus& status,
+                                const StateMachine& machine) noexcept {
+  send_state_changes(can, machine);
+  send_heartbeat(can, status, machine);
+}
+
+void Telemetry::send_state_changes(hal::CanBus& can, const StateMachine& machine) noexcept {
+  Transition t;
+  while (transitions_sent_ < machine.count()) {
+    if (machine.logged(transitions_sent_, t)) {
+      hal::CanFrame frame = encode_frame(
+          node_id_, MessageId::state_change,
+          {float(t.from), float(t.to), float(t.reason), float((transitions_sent_ + 1) & 0xFF)});
+      // Whole milliseconds exceed a float's 24-bit mantissa after 4.6 h: set the raw bits.
+      protocol::set_raw(frame.data, protocol::kStateChangeSignals[4], time_ms(t.tick));
+      send(can, frame);
+    }
+    ++transitions_sent_;  // a transition that fell out of the log is skipped
+  }
+}
+
+void Telemetry::send_heartbeat(hal::CanBus& can, const DriveStatus& status,
+                               const StateMachine& machine) noexcept {
+  send(can, encode_frame(node_id_, MessageId::heartbeat,
+                         {float(status.state), float(status.fault_bits), float(status.first_fault),
+                          float(heartbeat_count_++), float(status.command_counter),
+                          float(status.controller), status.can_bus_off ? 1.0f : 0.0f,
+                          float(status.rejected_commands & 0xFF), float(machine.count() & 0xFF)}));
 }
 
 void Telemetry::report_fault(hal::CanBus& can, const DriveStatus& status) noexcept {

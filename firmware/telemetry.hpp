@@ -41,6 +41,10 @@ class Telemetry {
   void publish(uint64_t k, hal::CanBus& can, const TickRecord& record, const DriveStatus& status,
                const StateMachine& machine, const ExecutionStats& execution,
                uint32_t budget_ns) noexcept;
+  /// A state_change frame for each transition not yet reported, then a heartbeat: the last
+  /// frames of a drive that is shutting down.
+  void final_heartbeat(hal::CanBus& can, const DriveStatus& status,
+                       const StateMachine& machine) noexcept;
   /// The fault_report frame, sent when a fault latches.
   void report_fault(hal::CanBus& can, const DriveStatus& status) noexcept;
   /// The command_ack frame for a command frame addressed to this node.
@@ -51,6 +55,9 @@ class Telemetry {
 
  private:
   void send(hal::CanBus& can, const hal::CanFrame& frame) noexcept;
+  void send_state_changes(hal::CanBus& can, const StateMachine& machine) noexcept;
+  void send_heartbeat(hal::CanBus& can, const DriveStatus& status,
+                      const StateMachine& machine) noexcept;
   uint32_t time_ms(uint64_t tick) const noexcept;
 
   uint8_t node_id_;

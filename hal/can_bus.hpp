@@ -19,6 +19,8 @@ class CanBus {
   virtual bool try_send(const CanFrame& frame) noexcept = 0;
   /// Takes the oldest received frame; false if none. Never blocks.
   virtual bool try_receive(CanFrame& frame) noexcept = 0;
+  /// The controller is bus-off (it has stopped sending after too many errors). Tick context.
+  virtual bool bus_off() const noexcept { return false; }
 };
 
 }  // namespace imd::hal

@@ -27,8 +27,16 @@ void SimBoard::latch_sensors() {
 }
 
 void SimBoard::run_tick() {
-  latch_sensors();
+  begin_period();
   timer_.fire();
+  end_period();
+}
+
+void SimBoard::begin_period() {
+  latch_sensors();
+}
+
+void SimBoard::end_period() {
   const double load_now_Nm = load_Nm();
   // What the firmware wrote this tick acts now (no latency) or from the next tick.
   const Vec2 written_analog(analog_.v_A_V(), analog_.v_B_V());

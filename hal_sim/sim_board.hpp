@@ -75,6 +75,11 @@ class SimBoard {
   const Vec2& start_current_alphabeta_A() const noexcept { return start_current_alphabeta_A_; }
 
   void run_tick();
+  /// run_tick() in two halves, for a firmware paced by another timer (the Linux real-time
+  /// loop): begin_period() latches the sensors at t_k, the caller runs the firmware's tick,
+  /// end_period() integrates [t_k, t_{k+1}]. The board's own timer() is not used then.
+  void begin_period();
+  void end_period();
 
   /// Applies a fault at once (FaultKind documents each); it lasts to the end of the run. Call
   /// between ticks: the next run_tick() sees it. Throws std::invalid_argument on a parameter

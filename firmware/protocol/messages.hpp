@@ -93,6 +93,7 @@ inline constexpr ValueName kFaultValues[] = {
     {12, "phase_loss"},
     {13, "command_timeout"},
     {14, "emergency_stop"},
+    {15, "enable_input"},
 };
 inline constexpr ValueName kControllerValues[] = {{0, "dsmc"}, {1, "iol"}};
 inline constexpr ValueName kCommandResultValues[] = {
@@ -101,7 +102,7 @@ inline constexpr ValueName kCommandResultValues[] = {
 };
 inline constexpr ValueName kTransitionReasonValues[] = {
     {0, "calibrated"}, {1, "enable"}, {2, "magnetized"},   {3, "disable"},
-    {4, "stopped"},    {5, "fault"},  {6, "clear_faults"},
+    {4, "stopped"},    {5, "fault"},  {6, "clear_faults"}, {7, "shutdown"},
 };
 
 // --- the E2E header every command starts with

@@ -46,11 +46,11 @@ struct CanRig {
     b.adc.noise_A = 0.01;
     return b;
   }
-  explicit CanRig(const DriveConfig& c = config())
+  explicit CanRig(const DriveConfig& c = config(), hal::Gpio* gpio = nullptr)
       : board(test::test_motors()[0].parameters, board_config()),
         drive(test::test_motors()[0].parameters, c,
               {board.pwm(), board.encoder(), board.adc(), board.timer(), nullptr, nullptr,
-               &board.can()},
+               &board.can(), gpio},
               unused) {
     board.timer().start(drive);
   }
@@ -265,6 +265,88 @@ TEST(DriveCommands, TelemetryRunsAtItsRates) {
   EXPECT_EQ(rig.count(MessageId::telemetry_current), 1000);
   EXPECT_EQ(rig.count(MessageId::telemetry_voltage), 1000);
   EXPECT_EQ(rig.drive.telemetry().dropped_frames(), 0u);
+}
+
+/// Board lines: 0 the enable input (set by the test), 1 the fault output, 2 the timing output.
+/// Records every write, and the timing line's level whenever the drive reads the enable input
+/// (which it does inside the tick).
+class RecordingGpio final : public hal::Gpio {
+ public:
+  static constexpr uint8_t kEnable = 0, kFault = 1, kTiming = 2;
+  bool enable_level = true;
+  bool level[3] = {false, false, false};
+  int writes[3] = {0, 0, 0};
+  mutable std::vector<bool> timing_at_read;
+
+  void write(uint8_t line, bool value) noexcept override {
+    if (line < 3) {
+      level[line] = value;
+      ++writes[line];
+    }
+  }
+  bool read(uint8_t line) const noexcept override {
+    timing_at_read.push_back(level[kTiming]);
+    return line == kEnable && enable_level;
+  }
+};
+
+DriveConfig gpio_config() {
+  DriveConfig c = CanRig::config();
+  c.enable_input_line = RecordingGpio::kEnable;
+  c.fault_output_line = RecordingGpio::kFault;
+  c.timing_output_line = RecordingGpio::kTiming;
+  return c;
+}
+
+TEST(DriveGpio, TimingLineIsHighWhileTheTickComputesAndLowBetweenTicks) {
+  RecordingGpio gpio;
+  CanRig rig(gpio_config(), &gpio);
+  rig.run(500);
+  EXPECT_EQ(gpio.writes[RecordingGpio::kTiming], 1000);  // up and down once per tick
+  EXPECT_FALSE(gpio.level[RecordingGpio::kTiming]);
+  ASSERT_EQ(gpio.timing_at_read.size(), 500u);
+  for (const bool high : gpio.timing_at_read) EXPECT_TRUE(high);
+}
+
+TEST(DriveGpio, EnableIsRefusedWhileTheEnableInputIsInactive) {
+  RecordingGpio gpio;
+  gpio.enable_level = false;
+  CanRig rig(gpio_config(), &gpio);
+  rig.run(300);
+  ASSERT_EQ(rig.drive.state(), DriveState::idle);
+  rig.send({CommandKind::enable});
+  rig.run(5);
+  EXPECT_EQ(rig.drive.state(), DriveState::idle);
+  EXPECT_FALSE(rig.board.pwm().enabled());
+  ASSERT_EQ(rig.acks().size(), 1u);
+  EXPECT_EQ(rig.acks()[0], CommandResult::not_allowed);
+  gpio.enable_level = true;
+  rig.send({CommandKind::enable});
+  rig.run(5);
+  EXPECT_EQ(rig.drive.state(), DriveState::magnetizing);
+}
+
+TEST(DriveGpio, LosingTheEnableInputTripsInTheSameTickAndRaisesTheFaultLine) {
+  RecordingGpio gpio;
+  CanRig rig(gpio_config(), &gpio);
+  rig.run(300);
+  rig.send({CommandKind::enable});
+  rig.run(20);
+  ASSERT_EQ(rig.drive.state(), DriveState::magnetizing);
+  ASSERT_TRUE(rig.board.pwm().enabled());
+  EXPECT_FALSE(gpio.level[RecordingGpio::kFault]);
+  gpio.enable_level = false;
+  rig.run(1);
+  EXPECT_EQ(rig.drive.state(), DriveState::fault);
+  EXPECT_EQ(rig.drive.fault(), FaultCode::enable_input);
+  EXPECT_FALSE(rig.board.pwm().enabled());
+  EXPECT_TRUE(gpio.level[RecordingGpio::kFault]);
+  EXPECT_EQ(gpio.writes[RecordingGpio::kFault], 1);  // written on the change only
+  rig.send({CommandKind::clear_faults});
+  rig.run(1);
+  EXPECT_EQ(rig.drive.state(), DriveState::idle);
+  EXPECT_FALSE(gpio.level[RecordingGpio::kFault]);
+  EXPECT_EQ(gpio.writes[RecordingGpio::kFault], 2);
 }
 
 }  // namespace

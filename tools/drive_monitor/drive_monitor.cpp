@@ -4,13 +4,22 @@
 //   drive_monitor watch (--can IFACE | --log FILE) [--node N] [--csv PATH] [--table | --no-table]
 //                       [--duration-s S]
 //   drive_monitor send --can IFACE --node N COMMAND [VALUE] [--counter C] [--wait-heartbeat-s S]
-//                      [--wait-ack-s S]
+//                      [--wait-ack-s S] [--repeat-hz F --for-s S]
 //
 // watch decodes node N's frames (default 1); the CSV's time_s is the log's timestamp, or with
 // --can the seconds since watch started. send learns the alive counter from the heartbeat.
+// With --repeat-hz F --for-s S (both or neither; F in (0, 1000] Hz) send sends the command
+// every 1/F s for S s, each frame with the next alive counter, and so keeps an enabled drive's
+// command watchdog fed (it needs a frame every command_timeout_s, 0.2 s by default). Acks are
+// matched as they come, --wait-ack-s per frame; SIGINT or SIGTERM ends the repetition early.
+// It prints one summary line: frames sent, accepted, rejected by reason, unanswered. The
+// emergency stop may be repeated too: the tool never stands in the way of a stop, and the
+// drive obeys every estop frame whatever its counter, so repeats are harmless redundancy.
 //
-// Exit codes: 0 success, 1 the CSV could not be written, 2 bad input (command line, interface,
-// log file), 3 command rejected, 4 no heartbeat or no acknowledgement.
+// Exit codes: 0 success (with --repeat-hz: every frame sent and accepted), 1 the CSV could not
+// be written, 2 bad input (command line, interface, log file), 3 a command frame rejected,
+// 4 no heartbeat or no acknowledgement (with --repeat-hz: none rejected, but some frame not
+// sent or unanswered).
 #include <poll.h>
 #include <unistd.h>
 #include <CLI/CLI.hpp>
@@ -26,9 +35,11 @@
 #include <sstream>
 #include <string>
 
+#include "firmware/protection/protection_config.hpp"
 #include "hal/linux/socketcan_bus.hpp"
 #include "tools/can_log/candump_log.hpp"
 #include "tools/drive_monitor/monitor.hpp"
+#include "tools/drive_monitor/repeat_send.hpp"
 #include "tools/drive_monitor/send_command.hpp"
 #include "tools/drive_monitor/status_table.hpp"
 
@@ -48,6 +59,39 @@ volatile std::sig_atomic_t g_stop = 0;
 extern "C" void on_signal(int) {
   g_stop = 1;
 }
+
+/// The signal mask wait_readable's ppoll waits with; nullptr: the present one.
+const sigset_t* g_wait_mask = nullptr;
+
+/// SIGINT and SIGTERM set g_stop. While an object lives they are blocked except inside
+/// wait_readable, whose ppoll unblocks them atomically: a signal that lands between a check of
+/// g_stop and the wait still ends the wait at once, not at its timeout (1/F s can be minutes at
+/// a low --repeat-hz).
+class StopSignals {
+ public:
+  StopSignals() {
+    struct sigaction action {};
+    action.sa_handler = on_signal;
+    sigemptyset(&action.sa_mask);
+    ::sigaction(SIGINT, &action, nullptr);
+    ::sigaction(SIGTERM, &action, nullptr);
+    sigset_t stop;
+    sigemptyset(&stop);
+    sigaddset(&stop, SIGINT);
+    sigaddset(&stop, SIGTERM);
+    ::sigprocmask(SIG_BLOCK, &stop, &previous_);
+    g_wait_mask = &previous_;
+  }
+  ~StopSignals() {
+    g_wait_mask = nullptr;
+    ::sigprocmask(SIG_SETMASK, &previous_, nullptr);
+  }
+  StopSignals(const StopSignals&) = delete;
+  StopSignals& operator=(const StopSignals&) = delete;
+
+ private:
+  sigset_t previous_{};
+};
 
 std::string seconds_text(double seconds) {
   std::ostringstream text;
@@ -71,6 +115,20 @@ const CLI::Validator kSeconds(
     },
     "SECONDS");
 
+/// A --repeat-hz rate in (0, kMaxRepeatRate_Hz].
+const CLI::Validator kRepeatRate(
+    [](std::string& text) -> std::string {
+      char* end = nullptr;
+      const double value = std::strtod(text.c_str(), &end);
+      if (end == text.c_str() || *end != '\0') return "must be a number, got " + text;
+      if (!(value > 0.0 && value <= imd::monitor::kMaxRepeatRate_Hz)) {
+        return "must be a rate in (0, " + seconds_text(imd::monitor::kMaxRepeatRate_Hz) +
+               "] Hz, got " + text;
+      }
+      return {};
+    },
+    "HZ");
+
 struct WatchOptions {
   std::string can;
   std::string log;
@@ -89,6 +147,7 @@ struct SendOptions {
   int counter = -1;
   double wait_heartbeat_s = 0.5;
   double wait_ack_s = 0.5;
+  std::optional<imd::monitor::RepeatPlan> repeat;  ///< --repeat-hz/--for-s; nullopt: send once
 };
 
 /// The CSV output, when asked for ("-": standard output).
@@ -118,11 +177,21 @@ class CsvOutput {
   std::ostream* stream_ = nullptr;
 };
 
-/// Waits until the socket has data or `deadline` passes (or a signal arrives).
+/// Waits until the socket has data or `deadline` passes (or a signal arrives). ppoll rather
+/// than poll for its nanosecond timeout (poll's milliseconds would make a wait up to a whole
+/// period late at 1000 Hz) and its atomic signal mask (StopSignals).
 void wait_readable(const imd::hal::SocketCanBus& bus, Clock::time_point deadline) {
-  const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - Clock::now());
+  const int64_t left_ns = std::max<int64_t>(
+      0, std::chrono::duration_cast<std::chrono::nanoseconds>(deadline - Clock::now()).count());
+  const timespec timeout{static_cast<time_t>(left_ns / 1'000'000'000),
+                         static_cast<long>(left_ns % 1'000'000'000)};
   pollfd fd{bus.native_handle(), POLLIN, 0};
-  ::poll(&fd, 1, static_cast<int>(std::max<int64_t>(0, left.count()) + 1));
+  ::ppoll(&fd, 1, &timeout, g_wait_mask);
+}
+
+/// The interface is gone or down: waiting for it to come back is not this tool's job.
+bool interface_lost(const imd::hal::SocketCanBus& bus) {
+  return bus.last_errno() == ENODEV || bus.last_errno() == ENETDOWN;
 }
 
 imd::monitor::BusInfo bus_info(const imd::hal::SocketCanBus& bus) {
@@ -188,7 +257,7 @@ int watch_live(const WatchOptions& o) {
       const double t_s = std::chrono::duration<double>(Clock::now() - start).count();
       csv.write(monitor.feed(t_s, frame));
     }
-    if (bus->last_errno() == ENODEV || bus->last_errno() == ENETDOWN) {
+    if (interface_lost(*bus)) {
       return fail(o.can + ": receive failed: " + std::strerror(bus->last_errno()));
     }
     if (Clock::now() >= next_refresh) {
@@ -224,6 +293,51 @@ bool receive_until(imd::hal::SocketCanBus& bus, double wait_s, Accept accept) {
   return false;
 }
 
+/// send --repeat-hz: the frames go out on CommandRepeater's schedule; between them the loop
+/// only sleeps until the next slot, the next ack deadline or a received frame, so an ack never
+/// holds up the next frame.
+int send_repeated(imd::hal::SocketCanBus& bus, const SendOptions& o,
+                  const imd::firmware::protocol::Command& command, uint8_t counter) {
+  const imd::monitor::RepeatPlan& plan = *o.repeat;
+  // Slower than the watchdog is allowed (a test may want it), but worth a word, except for the
+  // emergency stop, which leaves the drive faulted and its watchdog with nothing to guard.
+  const double default_timeout_s = imd::firmware::ProtectionConfig{}.command_timeout_s;
+  if (1.0 / plan.rate_Hz >= default_timeout_s &&
+      command.kind != imd::firmware::protocol::CommandKind::emergency_stop) {
+    std::cerr << "drive_monitor: note: a frame every " << seconds_text(1.0 / plan.rate_Hz)
+              << " s does not keep an enabled drive alive if its command_timeout_s is the "
+                 "default "
+              << seconds_text(default_timeout_s) << " s\n";
+  }
+  imd::monitor::CommandRepeater repeater(static_cast<uint8_t>(o.node), command, counter, plan,
+                                         Clock::now());
+  std::string bus_error;
+  imd::hal::CanFrame frame;
+  for (;;) {
+    if (g_stop != 0) repeater.stop(Clock::now());
+    while (bus.try_receive(frame)) repeater.receive(Clock::now(), frame);
+    const Clock::time_point now = Clock::now();
+    if (const auto due = repeater.frame_due(now)) repeater.sent(now, bus.try_send(*due));
+    if (bus_error.empty() && interface_lost(bus)) {
+      bus_error = o.can + ": " + std::strerror(bus.last_errno());
+      repeater.stop(now);
+    }
+    if (repeater.finished(now)) break;
+    wait_readable(bus, repeater.next_event());
+  }
+  if (!bus_error.empty()) std::cerr << "drive_monitor: " << bus_error << '\n';
+  std::cout << imd::monitor::repeat_summary(repeater.tally(), command, plan.rate_Hz) << '\n';
+  switch (imd::monitor::verdict(repeater.tally())) {
+    case imd::monitor::RepeatVerdict::all_accepted:
+      return 0;
+    case imd::monitor::RepeatVerdict::rejected:
+      return kExitRejected;
+    case imd::monitor::RepeatVerdict::not_all_accepted:
+      break;
+  }
+  return kExitNoAnswer;
+}
+
 int send(const SendOptions& o) {
   namespace protocol = imd::firmware::protocol;
   std::string error;
@@ -232,7 +346,7 @@ int send(const SendOptions& o) {
   const auto bus = imd::hal::SocketCanBus::open(o.can, error);
   if (!bus) return fail(error);
   const auto node = static_cast<uint8_t>(o.node);
-  std::signal(SIGINT, on_signal);
+  const StopSignals stop_signals;
 
   uint8_t counter = static_cast<uint8_t>(o.counter);
   if (o.counter < 0) {
@@ -248,10 +362,11 @@ int send(const SendOptions& o) {
     }
     counter = static_cast<uint8_t>((*last + 1) & 0x0F);
   }
+  receive_until(*bus, 0.0, [](const imd::hal::CanFrame&) { return false; });  // drop old frames
+  if (o.repeat) return send_repeated(*bus, o, *command, counter);
   protocol::CommandEncoder encoder(node, counter);
   const imd::hal::CanFrame frame = encoder.encode(*command);
   const auto message_id = protocol::message_of(frame.id);
-  receive_until(*bus, 0.0, [](const imd::hal::CanFrame&) { return false; });  // drop old frames
   if (!bus->try_send(frame)) {
     return fail(o.can + ": could not send (transmit queue full or interface down)", kExitNoAnswer);
   }
@@ -289,7 +404,8 @@ int main(int argc, char** argv) {
       ->check(kSeconds);
 
   SendOptions s;
-  CLI::App* send_cmd = app.add_subcommand("send", "Send one command and print its ack");
+  CLI::App* send_cmd = app.add_subcommand(
+      "send", "Send a command and print its ack, or repeat it (--repeat-hz, --for-s)");
   send_cmd->add_option("--can", s.can, "CAN interface (SocketCAN), e.g. can0")->required();
   send_cmd->add_option("--node", s.node, "Node id of the drive")
       ->check(CLI::Range(0, imd::firmware::protocol::kMaxNodeId))
@@ -305,6 +421,19 @@ int main(int argc, char** argv) {
   send_cmd->add_option("--wait-ack-s", s.wait_ack_s, "How long to wait for the command_ack")
       ->check(kSeconds)
       ->capture_default_str();
+  double repeat_Hz = 0.0;
+  double for_s = 0.0;
+  CLI::Option* repeat_option =
+      send_cmd
+          ->add_option("--repeat-hz", repeat_Hz,
+                       "Send the command at this rate, each frame with the next counter (a "
+                       "keep-alive: the drive's watchdog wants one every 0.2 s by default)")
+          ->check(kRepeatRate);
+  CLI::Option* for_option =
+      send_cmd->add_option("--for-s", for_s, "How long to repeat (with --repeat-hz)")
+          ->check(kSeconds);
+  repeat_option->needs(for_option);
+  for_option->needs(repeat_option);
 
   try {
     app.parse(argc, argv);
@@ -317,5 +446,8 @@ int main(int argc, char** argv) {
     return w.log.empty() ? watch_live(w) : watch_log(w);
   }
   if (value_option->count() > 0) s.value = value;
+  if (repeat_option->count() > 0) {
+    s.repeat = imd::monitor::RepeatPlan{repeat_Hz, for_s, s.wait_ack_s};
+  }
   return send(s);
 }

@@ -144,16 +144,22 @@ std::optional<uint8_t> heartbeat_command_counter(const hal::CanFrame& frame, uin
   return static_cast<uint8_t>(d.signals[std::size_t(index)].raw);
 }
 
-std::optional<Ack> match_ack(const hal::CanFrame& frame, uint8_t node_id, uint8_t message_id,
-                             uint8_t counter) {
+std::optional<AckFrame> decode_ack(const hal::CanFrame& frame, uint8_t node_id) {
   const DecodedFrame d = decode_frame(frame, node_id);
   if (d.kind != FrameKind::decoded || d.message->id != MessageId::command_ack) return std::nullopt;
   const auto raw = [&d](const char* name) {
     return d.signals[std::size_t(protocol::find_signal(*d.message, name))].raw;
   };
-  if (raw("message") != message_id || raw("counter") != counter) return std::nullopt;
-  return Ack{static_cast<protocol::CommandResult>(raw("result")),
-             static_cast<uint16_t>(raw("rejected_total"))};
+  return AckFrame{static_cast<uint8_t>(raw("message")), static_cast<uint8_t>(raw("counter")),
+                  Ack{static_cast<protocol::CommandResult>(raw("result")),
+                      static_cast<uint16_t>(raw("rejected_total"))}};
+}
+
+std::optional<Ack> match_ack(const hal::CanFrame& frame, uint8_t node_id, uint8_t message_id,
+                             uint8_t counter) {
+  const std::optional<AckFrame> a = decode_ack(frame, node_id);
+  if (!a || a->message_id != message_id || a->counter != counter) return std::nullopt;
+  return a->ack;
 }
 
 std::string result_name(protocol::CommandResult result) {

@@ -32,6 +32,16 @@ struct Ack {
   uint16_t rejected_total;
 };
 
+/// A command_ack and the frame it answers.
+struct AckFrame {
+  uint8_t message_id;
+  uint8_t counter;
+  Ack ack;
+};
+
+/// The ack if `frame` is node `node_id`'s command_ack, for whichever frame it answers.
+std::optional<AckFrame> decode_ack(const hal::CanFrame& frame, uint8_t node_id);
+
 /// The ack if `frame` is node `node_id`'s command_ack for message `message_id` with `counter`.
 std::optional<Ack> match_ack(const hal::CanFrame& frame, uint8_t node_id, uint8_t message_id,
                              uint8_t counter);

@@ -7,23 +7,12 @@
 #include "control/exact_model_001.hpp"
 #include "control/frames.hpp"
 #include "firmware/drive.hpp"
+#include "firmware/sim/scenario_config.hpp"
 #include "hal_sim/sim_board.hpp"
 #include "tools/drive_sim/scripted_commands.hpp"
 
 namespace imd::sim {
 namespace {
-
-class ScenarioReferences final : public firmware::ReferenceSource {
- public:
-  explicit ScenarioReferences(const Scenario& s) : s_(s) {}
-  firmware::Reference at_tick(uint64_t k) const noexcept override {
-    const double t_s = double(k) * s_.sample_period_s;
-    return {s_.speed.at(t_s), s_.flux2_Wb2, s_.torque.at(t_s), s_.stator_flux2_Wb2};
-  }
-
- private:
-  const Scenario& s_;
-};
 
 /// The plant's state in the rotor frame: the "ideal sensors" of paper 000, Section III.
 class PlantOracle final : public firmware::StateOracle {
@@ -43,90 +32,13 @@ class PlantOracle final : public firmware::StateOracle {
   const SimBoard& board_;
 };
 
-SimBoardConfig board_config(const Scenario& s) {
-  SimBoardConfig c;
-  c.period_s = s.sample_period_s;
-  c.substeps = s.substeps;
-  c.pwm_latency_ticks = s.pwm_latency_ticks;
-  c.inner_feedback = s.inner_feedback;
-  c.current_source = s.current_fed;
-  c.v_bus_V = s.v_bus_V;
-  c.encoder_cpr = s.encoder_cpr;
-  c.adc = s.adc;
-  c.seed = s.seed;
-  return c;
-}
-
-firmware::DriveConfig drive_config(const Scenario& s) {
-  firmware::DriveConfig c;
-  c.sample_period_s = s.sample_period_s;
-  c.controller =
-      s.controller == "iol" ? firmware::ControllerKind::iol : firmware::ControllerKind::dsmc;
-  c.iol_period_s = s.iol_period_s;
-  c.current_source = s.current_fed;
-  c.outer_speed_loop = s.outer_speed_loop;
-  c.outer_flux_loop = s.outer_flux_loop;
-  c.speed_loop_bandwidth_rad_s = s.speed_loop_bandwidth_rad_s;
-  c.torque_limit_Nm = s.torque_limit_Nm;
-  c.flux_loop_time_constant_s = s.flux_loop_time_constant_s;
-  c.magnetized_fraction = s.magnetized_fraction;
-  c.magnetizing_current_A = s.magnetizing_current_A;
-  c.analog_inner_loop = s.inner_feedback == InnerFeedback::ideal_analog;
-  c.pwm_latency_ticks = s.pwm_latency_ticks;
-  c.compensate_latency = s.compensate_latency;
-  c.i_max_A = s.i_max_A;
-  c.voltage_limited = s.limit_voltage;
-  c.max_accel_rad_s2 = s.max_accel_rad_s2;
-  c.speed_reaching_pole = s.speed_reaching_pole;
-  c.flux_reaching_pole = s.flux_reaching_pole;
-  // Commands: a profile runs at once; over CAN the script enables the drive.
-  c.commands_over_can = s.command_source == "can";
-  c.auto_enable = !c.commands_over_can;
-  c.node_id = static_cast<uint8_t>(s.can_node_id);
-  c.telemetry_rate_Hz = static_cast<int>(std::lround(s.telemetry_rate_Hz));
-  c.flux2_ref_Wb2 = s.flux2_Wb2;
-  c.stator_flux2_ref_Wb2 = s.stator_flux2_Wb2;
-  c.max_flux2_Wb2 = 2.0 * std::max(s.flux2_Wb2, s.stator_flux2_Wb2);
-  // Protection: defaults from the scenario's board, then its [protection] table.
-  firmware::ProtectionConfig& p = c.protection;
-  const ProtectionSettings& set = s.protection;
-  p.overcurrent_A = set.overcurrent_A.value_or(1.5 * s.i_max_A);
-  p.bus_min_V = set.bus_min_V.value_or(0.7 * s.v_bus_V);  // +-30 % of the nominal bus
-  p.bus_max_V = set.bus_max_V.value_or(1.3 * s.v_bus_V);
-  p.overspeed_rad_s = set.overspeed_rad_s.value_or(p.overspeed_rad_s);
-  p.encoder_missing_counts = set.encoder_missing_counts.value_or(p.encoder_missing_counts);
-  p.adc_stuck_ticks = set.adc_stuck_ticks.value_or(p.adc_stuck_ticks);
-  p.phase_loss_ratio = set.phase_loss_ratio.value_or(p.phase_loss_ratio);
-  p.phase_loss_min_current_A = set.phase_loss_min_current_A.value_or(p.phase_loss_min_current_A);
-  p.command_timeout_s = set.command_timeout_s.value_or(p.command_timeout_s);
-  // Lock-step simulation: the host's wall-clock time per tick is not the MCU's, so the budget
-  // is checked only when the scenario sets one.
-  p.tick_budget_ns = static_cast<uint32_t>(std::lround(set.tick_budget_us.value_or(0.0) * 1e3));
-  c.stop_decel_rad_s2 = set.stop_decel_rad_s2.value_or(c.stop_decel_rad_s2);
-  c.adc_calibration_ticks = s.ideal_sensors ? 0 : 256;
-  c.adc_offset_limit_A = 0.02 * s.adc.full_scale_A;  // 2 % of full scale (0.2 A on 10 A)
-  c.section_iv_load_estimator = s.section_iv;
-  c.encoder_observer_bandwidth_rad_s = s.encoder_bandwidth_rad_s;
-  c.load_estimator_pole = s.load_estimator_pole;
-  return c;
-}
-
 template <typename T>
 Summary run(const Scenario& s, const RunCallbacks& callbacks) {
-  SimBoard board(s.motor, board_config(s));
-  board.set_load_profile(s.load);
-  {  // at rest at initial_theta; magnetized (Phi = Lm I, along A) if initial_flux2 > 0
-    PlantState start;
-    start.theta_mech_rad = s.initial_theta_mech_rad;
-    const auto rotor =
-        control::Rotation<double>::from_angle(s.motor.pole_pairs * s.initial_theta_mech_rad);
-    start.flux_r_alphabeta_Wb = rotor.apply(Vec2(std::sqrt(s.initial_flux2_Wb2), 0.0));
-    start.i_s_alphabeta_A = rotor.apply(Vec2(std::sqrt(s.initial_flux2_Wb2) / s.motor.Lm_H, 0.0));
-    board.plant().set_state(start);
-  }
-  const ScenarioReferences references(s);
+  SimBoard board(s.motor, firmware::board_config(s));
+  firmware::prepare_board(board, s);
+  const firmware::ScenarioReferences references(s);
   const PlantOracle oracle(board);
-  firmware::Drive<T> drive(s.motor, drive_config(s),
+  firmware::Drive<T> drive(s.motor, firmware::drive_config(s),
                            {board.pwm(), board.encoder(), board.adc(), board.timer(),
                             &board.analog_inner_loop(), &board.current_source(), &board.can()},
                            references, s.ideal_sensors ? &oracle : nullptr);

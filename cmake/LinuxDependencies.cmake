@@ -1,0 +1,25 @@
+# Third-party libraries of the Linux programs (the simulated board, drive_hil, drive_monitor
+# and the host tools). Native builds use Debian's packages as they are. A cross build links
+# statically for a bare initramfs, and Debian ships toml++ and fmt for arm64 as shared
+# libraries only: there both are used in their header-only modes (the headers are the same).
+find_package(CLI11 REQUIRED)
+find_package(nlohmann_json 3 REQUIRED)
+if(NOT CMAKE_CROSSCOMPILING)
+  find_package(tomlplusplus REQUIRED)
+  find_package(fmt REQUIRED)
+else()
+  find_path(IMD_TOMLPP_INCLUDE_DIR toml++/toml.h)
+  find_path(IMD_FMT_INCLUDE_DIR fmt/format.h)
+  if(NOT IMD_TOMLPP_INCLUDE_DIR OR NOT IMD_FMT_INCLUDE_DIR)
+    message(FATAL_ERROR "toml++ or fmt headers not found: install Debian's libtomlplusplus-dev "
+                        "and libfmt-dev (tools/install_deps.sh)")
+  endif()
+  add_library(tomlplusplus::tomlplusplus INTERFACE IMPORTED)
+  set_target_properties(tomlplusplus::tomlplusplus PROPERTIES
+    INTERFACE_INCLUDE_DIRECTORIES "${IMD_TOMLPP_INCLUDE_DIR}"
+    INTERFACE_COMPILE_DEFINITIONS "TOML_HEADER_ONLY=1")
+  add_library(fmt::fmt INTERFACE IMPORTED)
+  set_target_properties(fmt::fmt PROPERTIES
+    INTERFACE_INCLUDE_DIRECTORIES "${IMD_FMT_INCLUDE_DIR}"
+    INTERFACE_COMPILE_DEFINITIONS "FMT_HEADER_ONLY=1")
+endif()

@@ -1,0 +1,49 @@
+#pragma once
+/// One real-time period of the host-in-the-loop run: the simulated board latches its sensors,
+/// the drive runs its tick, the plant integrates the period. The Linux timer calls it; the
+/// plant thus advances one period per tick, in lock-step with the firmware's time base.
+/// The scenario's [[faults]] are injected at their simulated times, between ticks.
+#include <atomic>
+#include <cmath>
+#include <cstddef>
+#include <vector>
+
+#include "firmware/drive.hpp"
+#include "hal/control_timer.hpp"
+#include "hal_sim/sim_board.hpp"
+
+namespace imd::firmware {
+
+template <typename T>
+class HilTick final : public hal::TickHandler {
+ public:
+  /// `faults` sorted by time and already validated (SimBoard::inject must not throw here).
+  HilTick(sim::SimBoard& board, Drive<T>& drive, std::vector<sim::FaultInjection> faults)
+      : board_(board), drive_(drive), faults_(std::move(faults)) {}
+
+  void on_tick() noexcept override {
+    const double t_s = double(ticks_) * board_.config().period_s;
+    for (; next_fault_ < faults_.size() && faults_[next_fault_].at_s <= t_s + 1e-12; ++next_fault_) {
+      board_.inject(faults_[next_fault_]);
+    }
+    board_.begin_period();
+    drive_.on_tick();
+    board_.end_period();
+    ++ticks_;
+    const double omega = board_.plant().state().omega_mech_rad_s;
+    if (!std::isfinite(omega)) diverged_.store(true);  // the program stops the run
+  }
+
+  bool plant_diverged() const noexcept { return diverged_.load(); }
+  std::size_t faults_injected() const noexcept { return next_fault_; }
+
+ private:
+  sim::SimBoard& board_;
+  Drive<T>& drive_;
+  std::vector<sim::FaultInjection> faults_;
+  std::size_t next_fault_ = 0;
+  uint64_t ticks_ = 0;
+  std::atomic<bool> diverged_{false};
+};
+
+}  // namespace imd::firmware

@@ -1,0 +1,36 @@
+#pragma once
+/// What a scenario file describes, as the firmware's and the simulated board's configuration.
+/// Shared by every runner of the drive against the simulated plant: drive_sim (lock-step, as
+/// fast as it goes), drive_hil (real time, over SocketCAN) and the sim-tier tests.
+#include <cstdint>
+
+#include "firmware/drive_config.hpp"
+#include "firmware/reference_source.hpp"
+#include "hal_sim/scenario.hpp"
+#include "hal_sim/sim_board.hpp"
+
+namespace imd::firmware {
+
+/// The board: period, integration, latency, sensors, bus.
+sim::SimBoardConfig board_config(const sim::Scenario& s);
+
+/// The scenario's load profile and initial plant state: at rest at initial_theta, magnetized
+/// (Phi = Lm I, along A) if initial_flux2 > 0.
+void prepare_board(sim::SimBoard& board, const sim::Scenario& s);
+
+/// The drive: controller, limits, commands, and protection (defaults from the board, then the
+/// scenario's [protection] table). In lock-step simulation the tick budget is checked only when
+/// the scenario sets one (the host's wall-clock time per tick is not the MCU's).
+DriveConfig drive_config(const sim::Scenario& s);
+
+/// The scenario's speed, flux and torque profiles as the drive's reference source.
+class ScenarioReferences final : public ReferenceSource {
+ public:
+  explicit ScenarioReferences(const sim::Scenario& s) : s_(s) {}
+  Reference at_tick(uint64_t k) const noexcept override;
+
+ private:
+  const sim::Scenario& s_;
+};
+
+}  // namespace imd::firmware
