@@ -267,6 +267,28 @@ TEST(DriveCommands, TelemetryRunsAtItsRates) {
   EXPECT_EQ(rig.drive.telemetry().dropped_frames(), 0u);
 }
 
+TEST(DriveCommands, ShutDownTurnsThePwmOffAndSendsAFinalHeartbeatInIdle) {
+  CanRig rig;
+  rig.run(300);
+  rig.send({CommandKind::enable});
+  rig.run(20);
+  ASSERT_EQ(rig.drive.state(), DriveState::magnetizing);
+  ASSERT_TRUE(rig.board.pwm().enabled());
+  rig.sent.clear();
+  rig.drive.shut_down(rig.board.timer().tick_count());
+  for (const hal::CanFrame& f : rig.board.can_side().take_sent()) rig.sent.push_back(f);
+  EXPECT_FALSE(rig.board.pwm().enabled());
+  EXPECT_EQ(rig.drive.state(), DriveState::idle);
+  // The state_change (magnetizing -> idle, shutdown), then the heartbeat saying idle.
+  ASSERT_EQ(rig.sent.size(), 2u);
+  EXPECT_EQ(rig.sent[0].id, protocol::can_id(1, MessageId::state_change));
+  EXPECT_EQ(protocol::get_raw(rig.sent[0].data, protocol::kStateChangeSignals[2]),
+            uint32_t(TransitionReason::shutdown));
+  EXPECT_EQ(rig.sent[1].id, protocol::can_id(1, MessageId::heartbeat));
+  EXPECT_EQ(protocol::get_raw(rig.sent[1].data, protocol::kHeartbeatSignals[0]),
+            uint32_t(DriveState::idle));
+}
+
 /// Board lines: 0 the enable input (set by the test), 1 the fault output, 2 the timing output.
 /// Records every write, and the timing line's level whenever the drive reads the enable input
 /// (which it does inside the tick).

@@ -38,6 +38,19 @@ TEST(StateMachine, FollowsTheGraphAndLogsEveryTransition) {
   EXPECT_FALSE(m.logged(5, t));
 }
 
+TEST(StateMachine, ShutdownLeadsFromAModulatingStateToIdleOnly) {
+  StateMachine m;
+  EXPECT_FALSE(m.go(DriveState::idle, TransitionReason::shutdown, 1));  // calibrating: no
+  ASSERT_TRUE(m.go(DriveState::idle, TransitionReason::calibrated, 2));
+  ASSERT_TRUE(m.go(DriveState::magnetizing, TransitionReason::enable, 3));
+  ASSERT_TRUE(m.go(DriveState::running, TransitionReason::magnetized, 4));
+  EXPECT_FALSE(m.go(DriveState::stopping, TransitionReason::shutdown, 5));  // to idle only
+  EXPECT_TRUE(m.go(DriveState::idle, TransitionReason::shutdown, 6));
+  ASSERT_TRUE(m.go(DriveState::fault, TransitionReason::fault, 7));
+  EXPECT_FALSE(m.go(DriveState::idle, TransitionReason::shutdown, 8));  // a fault stays latched
+  EXPECT_EQ(m.state(), DriveState::fault);
+}
+
 TEST(StateMachine, KeepsTheLastTransitionsWhenTheLogWraps) {
   StateMachine m;
   m.go(DriveState::idle, TransitionReason::calibrated, 0);
