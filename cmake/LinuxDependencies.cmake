@@ -1,10 +1,11 @@
 # Third-party libraries of the Linux programs (the simulated board, drive_hil, drive_monitor
-# and the host tools). Native builds use Debian's packages as they are. A cross build links
-# statically for a bare initramfs, and Debian ships toml++ and fmt for arm64 as shared
-# libraries only: there both are used in their header-only modes (the headers are the same).
+# and the host tools). Native builds use Debian's packages as they are. A static build
+# (IMD_STATIC_LINK: the aarch64 cross build, and the programs the qemu tier boots) cannot link
+# toml++ and fmt as Debian ships them, shared libraries only: there both are used in their
+# header-only modes (the same headers).
 find_package(CLI11 REQUIRED)
 find_package(nlohmann_json 3 REQUIRED)
-if(NOT CMAKE_CROSSCOMPILING)
+if(NOT IMD_STATIC_LINK)
   find_package(tomlplusplus REQUIRED)
   find_package(fmt REQUIRED)
 else()

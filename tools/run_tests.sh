@@ -1,8 +1,9 @@
 #!/bin/sh
-# Test job: builds the host preset (Release with assertions) and runs every test tier.
+# Test job: builds the host preset (Release with assertions) and runs every test tier, the
+# qemu tier included (QEMU, the aarch64 cross toolchain and Debian's kernels: see tests/qemu).
 set -eu
 cd "$(dirname "$0")/.."
-tools/install_deps.sh
+tools/install_deps.sh --qemu --aarch64
 cmake --preset host
 cmake --build --preset host
 ctest --preset host --parallel 2
