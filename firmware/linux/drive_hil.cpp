@@ -272,6 +272,8 @@ int main(int argc, char** argv) {
   }
   const std::string memory_warning = imd::hal::lock_memory();
   if (!memory_warning.empty()) warnings.push_back(memory_warning);
+  const imd::hal::CpuIdleLatencyRequest idle_latency;
+  if (!idle_latency.warning().empty()) warnings.push_back(idle_latency.warning());
 
   return scenario.precision == "float"
              ? run<float>(o, scenario, can.get(), gpio.get(), lines, signals, warnings)

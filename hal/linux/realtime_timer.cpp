@@ -1,6 +1,8 @@
 #include "hal/linux/realtime_timer.hpp"
 
+#include <fcntl.h>
 #include <sched.h>
+#include <unistd.h>
 #include <sys/mman.h>
 #include <time.h>
 
@@ -32,6 +34,19 @@ std::string lock_memory() {
   return std::string("mlockall: ") + std::strerror(errno) +
          ": memory is not locked, a page fault may delay a tick (run as root, or raise "
          "RLIMIT_MEMLOCK)";
+}
+
+CpuIdleLatencyRequest::CpuIdleLatencyRequest() {
+  fd_ = ::open("/dev/cpu_dma_latency", O_WRONLY | O_CLOEXEC);
+  const int32_t zero_us = 0;
+  if (fd_ < 0 || ::write(fd_, &zero_us, sizeof zero_us) != sizeof zero_us) {
+    warning_ = std::string("/dev/cpu_dma_latency: ") + std::strerror(errno) +
+               ": the CPUs may enter deep idle states, which delays the loop's wake-ups";
+  }
+}
+
+CpuIdleLatencyRequest::~CpuIdleLatencyRequest() {
+  if (fd_ >= 0) ::close(fd_);  // closing ends the request
 }
 
 void RealtimeTimer::start(TickHandler& handler) noexcept {

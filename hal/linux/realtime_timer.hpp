@@ -32,6 +32,23 @@ struct RealtimeOptions {
 /// Returns "" or a warning saying why not and what it means.
 std::string lock_memory();
 
+/// Asks the kernel to keep the CPUs out of deep idle states while this object lives (writes 0
+/// to /dev/cpu_dma_latency and holds it open, as cyclictest does): waking from a deep C-state,
+/// or on a VM from a halted virtual CPU, adds tens of microseconds to a tick's wake-up.
+class CpuIdleLatencyRequest {
+ public:
+  CpuIdleLatencyRequest();
+  ~CpuIdleLatencyRequest();
+  CpuIdleLatencyRequest(const CpuIdleLatencyRequest&) = delete;
+  CpuIdleLatencyRequest& operator=(const CpuIdleLatencyRequest&) = delete;
+  /// "" or why the request could not be made and what it means.
+  const std::string& warning() const noexcept { return warning_; }
+
+ private:
+  int fd_ = -1;
+  std::string warning_;
+};
+
 /// The wall-clock time of CLOCK_MONOTONIC in ns.
 uint64_t monotonic_ns() noexcept;
 
