@@ -228,10 +228,9 @@ int main(int argc, char** argv) {
   imd::sim::Scenario scenario;
   try {
     scenario = imd::sim::load_scenario(o.scenario, o.overrides);
-    for (const imd::sim::FaultInjection& fault : scenario.faults) {  // checked here, not in the tick
-      imd::sim::SimBoard probe(scenario.motor, imd::firmware::board_config(scenario));
-      probe.inject(fault);
-    }
+    // The faults are checked here, on a board of their own: the tick must not throw.
+    imd::sim::SimBoard probe(scenario.motor, imd::firmware::board_config(scenario));
+    for (const imd::sim::FaultInjection& fault : scenario.faults) probe.inject(fault);
   } catch (const imd::sim::ConfigError& error) {
     return fail(error.what());
   } catch (const std::invalid_argument& error) {

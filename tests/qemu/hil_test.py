@@ -59,6 +59,8 @@ def states_in_order(rows):
 
 def check_main_run(out, c):
     rows = read_rows(out / "telemetry.csv")
+    # 50 Hz telemetry over a run of well over 10 s of simulated time gives hundreds of rows; 50
+    # is one second's worth, enough for the checks below to mean something.
     c.check(len(rows) > 50, "telemetry decoded by drive_monitor", f"{len(rows)} rows")
     states = states_in_order(rows)
     print(f"hil_test: states seen: {' -> '.join(states)}")
@@ -71,12 +73,17 @@ def check_main_run(out, c):
             f"found {want[:position]}")
 
     running = [r for r in rows if r["state"] == "running"]
+    # The reference is sent in 0.01 rad/s steps. The step lasts 6 s of wall clock, over 1 s
+    # simulated even at the emulator's slowest pace: 8 rows (0.16 s at 50 Hz) is a floor that
+    # only a drive that never reached the step misses.
     at_step = [r for r in running if abs(float(r["speed_ref_rad_s"]) - STEP_RAD_S) < 0.01]
     if c.check(len(at_step) >= 8, "the speed reference reached the 30 rad/s step",
                f"{len(at_step)} rows"):
         settled = at_step[len(at_step) // 2:]  # the ramp takes 75 ms, the step lasts seconds
         error = sum(abs(float(r["speed_rad_s"]) - STEP_RAD_S) for r in settled) / len(settled)
         start = float(running[0]["speed_rad_s"])
+        # At rest before the step (0 rad/s commanded, no load); 5 rad/s tells rest from a
+        # rotor still turning, far above the estimate's noise of a few 0.01 rad/s.
         c.check(abs(start) < 5.0, "the speed started from rest", f"{start:.2f} rad/s")
         c.check(error < SPEED_TOLERANCE_RAD_S, "the speed follows the step",
                 f"mean |speed - 30| = {error:.3f} rad/s over {len(settled)} rows "
