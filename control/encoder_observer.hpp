@@ -52,8 +52,16 @@ inline Eigen::Matrix3d encoder_observer_error_matrix(const ExactModel000Coeffici
 template <typename T>
 T wrap_pi(T angle_rad) noexcept {
   const T two_pi = T(2 * std::numbers::pi);
-  angle_rad = std::fmod(angle_rad + T(std::numbers::pi), two_pi);
-  return (angle_rad < T(0) ? angle_rad + two_pi : angle_rad) - T(std::numbers::pi);
+  T shifted = angle_rad + T(std::numbers::pi);
+  // Within two turns fmod is one exact subtraction (Sterbenz: two_pi <= x < 2 two_pi) or none;
+  // the tick's angles always are, and the MCU's fmodf costs as much as the rest of wrap_pi
+  // several times over. Farther out, fmod itself.
+  if (shifted >= two_pi && shifted < T(2) * two_pi) {
+    shifted -= two_pi;
+  } else if (!(shifted > -two_pi && shifted < two_pi)) {
+    shifted = std::fmod(shifted, two_pi);
+  }
+  return (shifted < T(0) ? shifted + two_pi : shifted) - T(std::numbers::pi);
 }
 
 template <typename T>

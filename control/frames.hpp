@@ -5,6 +5,8 @@
 #include <Eigen/Core>
 #include <cmath>
 
+#include "control/sin_cos.hpp"
+
 namespace imd::control {
 
 template <typename T>
@@ -30,9 +32,8 @@ struct Rotation {
   T sin_angle = T(0);
 
   static Rotation from_angle(T angle_rad) noexcept {
-    using std::cos;
-    using std::sin;
-    return {cos(angle_rad), sin(angle_rad)};
+    const CosSin<T> cs = cos_sin(angle_rad);
+    return {cs.cos, cs.sin};
   }
   /// e^{angle J} x: from the rotor-aligned frame to the stationary frame.
   Vec2<T> apply(const Vec2<T>& x) const noexcept {

@@ -27,11 +27,12 @@ uint64_t ticks(double duration_s, double period_s) noexcept {
 
 template <typename T>
 Drive<T>::Drive(const control::MotorParameters& motor, const DriveConfig& config,
-                const DrivePeripherals& peripherals, const ReferenceSource& references,
-                const StateOracle* oracle)
+                const DrivePeripherals& peripherals, const ReferenceSource<T>& references,
+                const StateOracle<T>* oracle)
     : config_(config),
+      limits_(limits(config)),
       hw_(peripherals),
-      commanded_(config.flux2_ref_Wb2, config.stator_flux2_ref_Wb2),
+      commanded_(T(config.flux2_ref_Wb2), T(config.stator_flux2_ref_Wb2)),
       references_(config.commands_over_can ? commanded_ : references),
       oracle_(oracle),
       coefficients_(control::discretize_seed000(motor, config.sample_period_s)),
@@ -87,6 +88,29 @@ Drive<T>::Drive(const control::MotorParameters& motor, const DriveConfig& config
 }
 
 template <typename T>
+typename Drive<T>::Limits Drive<T>::limits(const DriveConfig& c) noexcept {
+  const ProtectionConfig& p = c.protection;
+  Limits l;
+  l.adc_offset_limit_A = T(c.adc_offset_limit_A);
+  l.modulation_margin = T(c.modulation_margin);
+  l.current_limit_A = T(c.current_margin * c.i_max_A);
+  l.magnetizing_current_A = T(c.magnetizing_current_A);
+  l.magnetizing_current_max_A = T(0.9 * c.i_max_A);
+  l.magnetized_fraction = T(c.magnetized_fraction);
+  l.half_period_s = T(c.sample_period_s / 2);
+  l.stop_speed_rad_s = T(c.stop_speed_rad_s);
+  l.overcurrent_A = T(p.overcurrent_A);
+  l.bus_min_V = T(p.bus_min_V);
+  l.bus_max_V = T(p.bus_max_V);
+  l.overspeed_rad_s = T(p.overspeed_rad_s);
+  l.command_accel_step_rad_s = SpeedRamp<T>::step(c.max_accel_rad_s2, c.sample_period_s);
+  l.stop_accel_step_rad_s =
+      SpeedRamp<T>::step(std::min(c.max_accel_rad_s2, c.stop_decel_rad_s2), c.sample_period_s);
+  l.current_limited = std::isfinite(c.i_max_A);
+  return l;
+}
+
+template <typename T>
 void Drive<T>::pwm_off() noexcept {
   hw_.pwm.disable();
   // Neutral duties: a timer that starts from its last duties applies nothing stale on enable.
@@ -107,7 +131,7 @@ bool Drive<T>::enable_input_active() const noexcept {
 template <typename T>
 void Drive<T>::trip(FaultCode code, uint64_t k, uint8_t detail) noexcept {
   pwm_off();
-  commanded_.set_speed(0.0);  // after clear and enable, the host sends a new speed
+  commanded_.set_speed(T(0));  // after clear and enable, the host sends a new speed
   status_.fault_bits = static_cast<uint16_t>(status_.fault_bits | (1u << unsigned(code)));
   if (machine_.state() == DriveState::fault) return;  // the first fault is kept
   status_.first_fault = code;
@@ -137,7 +161,7 @@ bool Drive<T>::calibrate_adc(const hal::AdcSample& sample) noexcept {
   for (int phase = 0; phase < 3; ++phase) {
     offset_code_[phase] = T(calibration_sum_[phase]) / T(calibration_count_);
     const T offset_A = (offset_code_[phase] - T(scale.phase_mid_code)) * T(scale.phase_A_per_code);
-    if (std::abs(offset_A) > T(config_.adc_offset_limit_A)) {
+    if (std::abs(offset_A) > limits_.adc_offset_limit_A) {
       trip(FaultCode::adc_offset, hw_.timer.tick_count(), uint8_t(phase));
       return false;
     }
@@ -149,12 +173,12 @@ template <typename T>
 typename Drive<T>::Estimate Drive<T>::estimate(const hal::AdcSample& sample) noexcept {
   // Encoder: unwrap the free-running counter by differences, keep one revolution.
   const uint32_t count = hw_.encoder.count();
-  const int64_t cpr = hw_.encoder.counts_per_rev();
+  // 32-bit: the MCU divides those in hardware (cpr <= 2^30, |delta| < 2^31 - 2^30).
+  const auto cpr = static_cast<int32_t>(hw_.encoder.counts_per_rev());
   if (!encoder_started_) last_encoder_count_ = count;
   encoder_delta_counts_ = static_cast<int32_t>(count - last_encoder_count_);
-  encoder_position_ += encoder_delta_counts_;
   last_encoder_count_ = count;
-  encoder_position_ = ((encoder_position_ % cpr) + cpr) % cpr;
+  encoder_position_ = ((encoder_position_ + encoder_delta_counts_ % cpr) % cpr + cpr) % cpr;
   const T theta_measured_rad = T(2 * std::numbers::pi) * T(encoder_position_) / T(cpr);
   if (!encoder_started_) {  // the first reading sets the angle; speed and load start at rest
     encoder_observer_.reset(theta_measured_rad);
@@ -180,28 +204,28 @@ typename Drive<T>::Estimate Drive<T>::estimate(const hal::AdcSample& sample) noe
   }
   for (int phase = 0; phase < 3; ++phase) phase_current_A_[phase] = i_abc[phase];
   const Vec2 i_alphabeta = control::clarke(i_abc);
-  record_.i_alpha_A = double(i_alphabeta.x());
-  record_.i_beta_A = double(i_alphabeta.y());
+  record_.i_alpha_A = i_alphabeta.x();
+  record_.i_beta_A = i_alphabeta.y();
   e.x.i_s_AB_A =
       control::Rotation<T>::from_angle(pole_pairs_ * e.x.theta_mech_rad).apply_inverse(i_alphabeta);
 
   if (oracle_ != nullptr) {  // ideal sensors: current, speed and position are measured exactly
-    const TrueState truth = oracle_->true_state();
-    e.x.i_s_AB_A = Vec2(T(truth.i_s_A_A), T(truth.i_s_B_A));
+    const TrueState<T> truth = oracle_->true_state();
+    e.x.i_s_AB_A = Vec2(truth.i_s_A_A, truth.i_s_B_A);
     adc_saturated_ = false;  // the ADC is not used
     const auto true_abc = control::inverse_clarke(
-        Vec2(control::Rotation<T>::from_angle(pole_pairs_ * T(truth.theta_mech_rad))
+        Vec2(control::Rotation<T>::from_angle(pole_pairs_ * truth.theta_mech_rad)
                  .apply(e.x.i_s_AB_A)));
     peak_phase_current_A_ =
         std::max({std::abs(true_abc[0]), std::abs(true_abc[1]), std::abs(true_abc[2])});
     for (int phase = 0; phase < 3; ++phase) phase_current_A_[phase] = true_abc[phase];
-    e.x.omega_mech_rad_s = T(truth.omega_mech_rad_s);
-    e.x.theta_mech_rad = T(truth.theta_mech_rad);
+    e.x.omega_mech_rad_s = truth.omega_mech_rad_s;
+    e.x.theta_mech_rad = truth.theta_mech_rad;
     if (config_.section_iv_load_estimator) {
       e.load_Nm = load_estimator_.load_Nm();
     } else {
-      e.x.flux_r_AB_Wb = Vec2(T(truth.flux_r_A_Wb), T(truth.flux_r_B_Wb));
-      e.load_Nm = T(truth.load_Nm);
+      e.x.flux_r_AB_Wb = Vec2(truth.flux_r_A_Wb, truth.flux_r_B_Wb);
+      e.load_Nm = truth.load_Nm;
     }
   }
   return e;
@@ -219,26 +243,25 @@ control::InputDisk<T> Drive<T>::feasible_inputs(const control::RotorFrameState<T
   control::InputDisk<T> voltage, current;
   if (config_.voltage_limited) {
     voltage = {-compensation_AB(x),
-               T(config_.modulation_margin) * control::svpwm_linear_limit_V(v_bus_V)};
+               limits_.modulation_margin * control::svpwm_linear_limit_V(v_bus_V)};
   }
-  if (std::isfinite(config_.i_max_A)) {
-    current = {-(a21_ * x.flux_r_AB_Wb + a22_ * x.i_s_AB_A) / b2_,
-               T(config_.current_margin * config_.i_max_A) / b2_};
+  if (limits_.current_limited) {
+    current = {-(a21_ * x.flux_r_AB_Wb + a22_ * x.i_s_AB_A) / b2_, limits_.current_limit_A / b2_};
   }
   return control::inscribed_disk(voltage, current);
 }
 
 template <typename T>
 control::Vec2<T> Drive<T>::magnetizing_current(const control::RotorFrameState<T>& x,
-                                               const Reference& ref) const noexcept {
+                                               const Reference<T>& ref) const noexcept {
   // Steady state at zero slip: Phi_r = Lm I and phi_s = Ls I.
-  T current_A = T(config_.magnetizing_current_A);
+  T current_A = limits_.magnetizing_current_A;
   if (!(current_A > T(0))) {
     current_A = controller_ == ControllerKind::iol
-                    ? std::sqrt(std::max(T(ref.stator_flux2_Wb2), T(0))) / Ls_H_
-                    : std::sqrt(std::max(T(ref.flux2_Wb2), T(0))) / Lm_H_;
+                    ? std::sqrt(std::max(ref.stator_flux2_Wb2, T(0))) / Ls_H_
+                    : std::sqrt(std::max(ref.flux2_Wb2, T(0))) / Lm_H_;
   }
-  if (std::isfinite(config_.i_max_A)) current_A = std::min(current_A, T(0.9 * config_.i_max_A));
+  if (limits_.current_limited) current_A = std::min(current_A, limits_.magnetizing_current_max_A);
   const T flux = x.flux_r_AB_Wb.norm();
   const Vec2 direction = flux > T(1e-3) ? Vec2(x.flux_r_AB_Wb / flux) : Vec2(T(1), T(0));
   return current_A * direction;
@@ -251,24 +274,24 @@ T Drive<T>::magnetized_flux2(const control::RotorFrameState<T>& x) const noexcep
 }
 
 template <typename T>
-T Drive<T>::magnetized_flux2_ref(const Reference& ref) const noexcept {
-  return T(controller_ == ControllerKind::iol ? ref.stator_flux2_Wb2 : ref.flux2_Wb2);
+T Drive<T>::magnetized_flux2_ref(const Reference<T>& ref) const noexcept {
+  return controller_ == ControllerKind::iol ? ref.stator_flux2_Wb2 : ref.flux2_Wb2;
 }
 
 template <typename T>
 void Drive<T>::protect(uint64_t k, const Estimate& e, const hal::AdcSample& sample,
                        T v_bus_V) noexcept {
-  const ProtectionConfig& p = config_.protection;
+  const Limits& p = limits_;
   // In every state: what would harm the inverter or the motor even with the PWM off.
-  if (peak_phase_current_A_ > T(p.overcurrent_A) || adc_saturated_) {
+  if (peak_phase_current_A_ > p.overcurrent_A || adc_saturated_) {
     int phase = 0;
     for (int i = 1; i < 3; ++i) {
       if (std::abs(phase_current_A_[i]) > std::abs(phase_current_A_[phase])) phase = i;
     }
     trip(FaultCode::overcurrent, k, uint8_t(phase));
   }
-  if (v_bus_V > T(p.bus_max_V)) trip(FaultCode::bus_overvoltage, k);
-  if (std::abs(e.x.omega_mech_rad_s) > T(p.overspeed_rad_s)) trip(FaultCode::overspeed, k);
+  if (v_bus_V > p.bus_max_V) trip(FaultCode::bus_overvoltage, k);
+  if (std::abs(e.x.omega_mech_rad_s) > p.overspeed_rad_s) trip(FaultCode::overspeed, k);
   if (!finite(e.x.flux_r_AB_Wb) || !finite(e.x.i_s_AB_A) || !std::isfinite(e.x.omega_mech_rad_s) ||
       !std::isfinite(e.load_Nm)) {
     trip(FaultCode::non_finite, k);
@@ -284,7 +307,7 @@ void Drive<T>::protect(uint64_t k, const Estimate& e, const hal::AdcSample& samp
     return;
   }
   // While the inverter drives the motor.
-  if (!(v_bus_V >= T(p.bus_min_V))) trip(FaultCode::bus_undervoltage, k);  // NaN too
+  if (!(v_bus_V >= p.bus_min_V)) trip(FaultCode::bus_undervoltage, k);  // NaN too
   if (oracle_ == nullptr && adc_stuck_check_.stuck(sample.phase_code, u_written_V_)) {
     trip(FaultCode::adc_stuck, k);
   }
@@ -313,23 +336,23 @@ control::Vec2<T> Drive<T>::control(uint64_t k, const Estimate& e, T v_bus_V) noe
   // reference, so that the reaching law acts on the real error from the first running tick.
   // Stopping ramps the speed to zero at the stop deceleration.
   auto speed_target = [&](uint64_t tick) {
-    return stopping ? T(0) : T(references_.at_tick(tick).omega_mech_rad_s);
+    return stopping ? T(0) : references_.at_tick(tick).omega_mech_rad_s;
   };
   if (machine_.state() == DriveState::magnetizing) {
     speed_ramp_.reset(speed_ramp_.limited() ? e.x.omega_mech_rad_s : speed_target(k));
   }
   const T ramp_k1 = speed_ramp_.next(speed_ramp_.value(), speed_target(k + 1));
-  Reference ref_now = references_.at_tick(k + (latency ? 1 : 0));
-  Reference ref = references_.at_tick(k + (latency ? 2 : 1));
-  ref_now.omega_mech_rad_s = double(latency ? ramp_k1 : speed_ramp_.value());
-  ref.omega_mech_rad_s = double(latency ? speed_ramp_.next(ramp_k1, speed_target(k + 2)) : ramp_k1);
-  if (stopping) ref_now.torque_Nm = ref.torque_Nm = 0.0;
+  Reference<T> ref_now = references_.at_tick(k + (latency ? 1 : 0));
+  Reference<T> ref = references_.at_tick(k + (latency ? 2 : 1));
+  ref_now.omega_mech_rad_s = latency ? ramp_k1 : speed_ramp_.value();
+  ref.omega_mech_rad_s = latency ? speed_ramp_.next(ramp_k1, speed_target(k + 2)) : ramp_k1;
+  if (stopping) ref_now.torque_Nm = ref.torque_Nm = T(0);
   speed_ramp_.reset(ramp_k1);
   const control::InputDisk<T> feasible = feasible_inputs(x, v_bus_V);
   Vec2 v = Vec2::Zero();
   Vec2 i_command = Vec2::Zero();  // rotor-frame current command (magnetizing, iol)
   if (machine_.state() == DriveState::magnetizing) {
-    if (magnetized_flux2(e.x) >= T(config_.magnetized_fraction) * magnetized_flux2_ref(ref)) {
+    if (magnetized_flux2(e.x) >= limits_.magnetized_fraction * magnetized_flux2_ref(ref)) {
       machine_.go(DriveState::running, TransitionReason::magnetized, k);
       iol_stage_.start(magnetizing_current(x, ref));
     } else if (k - magnetizing_start_tick_ > magnetizing_timeout_ticks_) {
@@ -342,23 +365,23 @@ control::Vec2<T> Drive<T>::control(uint64_t k, const Estimate& e, T v_bus_V) noe
   const DriveState s = machine_.state();
   const bool controlling = s == DriveState::running || s == DriveState::stopping;
   if (controlling && controller_ == ControllerKind::iol) {
-    Reference boundary_ref = references_.at_tick(k + uint64_t(iol_stage_.ticks_per_period()));
+    Reference<T> boundary_ref = references_.at_tick(k + uint64_t(iol_stage_.ticks_per_period()));
     boundary_ref.omega_mech_rad_s = ref.omega_mech_rad_s;  // through the speed ramp
-    if (stopping) boundary_ref.torque_Nm = 0.0;
+    if (stopping) boundary_ref.torque_Nm = T(0);
     const IolTickResult<T> r =
         iol_stage_.tick(e.x.flux_r_AB_Wb, e.x.omega_mech_rad_s, boundary_ref);
     if (r.status != control::IolStatus::ok) trip(FaultCode::singular_control, k);
     i_command = r.i_cmd_AB_A;
-    record_.i_held_A_A = double(r.i_held_AB_A.x());
-    record_.i_held_B_A = double(r.i_held_AB_A.y());
+    record_.i_held_A_A = r.i_held_AB_A.x();
+    record_.i_held_B_A = r.i_held_AB_A.y();
     v = current_loop_.input(x.flux_r_AB_Wb, x.i_s_AB_A, i_command, feasible);
     record_.iol_boundary = r.boundary;
     if (r.boundary) {
-      record_.torque_ref_Nm = double(r.torque_ref_Nm);
-      record_.torque_cmd_Nm = double(r.torque_cmd_Nm);
-      record_.y2 = double(r.y2);
-      record_.y2_ref = double(r.y2_ref);
-      record_.stator_flux2_est_Wb2 = double(r.flux2_s_Wb2);
+      record_.torque_ref_Nm = r.torque_ref_Nm;
+      record_.torque_cmd_Nm = r.torque_cmd_Nm;
+      record_.y2 = r.y2;
+      record_.y2_ref = r.y2_ref;
+      record_.stator_flux2_est_Wb2 = r.flux2_s_Wb2;
       record_.torque_limited = r.torque_limited;
     }
   } else if (controlling) {
@@ -367,44 +390,44 @@ control::Vec2<T> Drive<T>::control(uint64_t k, const Estimate& e, T v_bus_V) noe
     in.i_s_AB_A = x.i_s_AB_A;
     in.omega_mech_rad_s = x.omega_mech_rad_s;
     in.load_Nm = e.load_Nm;
-    in.omega_ref_rad_s = T(ref_now.omega_mech_rad_s);
-    in.omega_ref_next_rad_s = T(ref.omega_mech_rad_s);
-    in.flux2_ref_Wb2 = T(ref_now.flux2_Wb2);
-    in.flux2_ref_next_Wb2 = T(ref.flux2_Wb2);
+    in.omega_ref_rad_s = ref_now.omega_mech_rad_s;
+    in.omega_ref_next_rad_s = ref.omega_mech_rad_s;
+    in.flux2_ref_Wb2 = ref_now.flux2_Wb2;
+    in.flux2_ref_next_Wb2 = ref.flux2_Wb2;
     in.feasible = feasible;
     const control::DsmcOutput<T> out = dsmc_.step(in);
     if (out.status != control::DsmcStatus::ok) trip(FaultCode::singular_control, k);
     v = out.v_AB_V;
-    record_.discriminant = double(out.discriminant);
-    record_.c_k = double(out.c_k);
-    record_.det_B = double(out.det_B);
+    record_.discriminant = out.discriminant;
+    record_.c_k = out.c_k;
+    record_.det_B = out.det_B;
     record_.speed_saturated = out.speed_saturated;
     record_.flux_saturated = out.flux_saturated;
   }
   record_.omega_ref_rad_s = ref.omega_mech_rad_s;
   record_.flux2_ref_Wb2 = ref.flux2_Wb2;
-  record_.controlled_flux2_ref_Wb2 = double(magnetized_flux2_ref(ref));
+  record_.controlled_flux2_ref_Wb2 = magnetized_flux2_ref(ref);
 
   // --- inner feedback (2) and limits. The held voltage is rotated to the middle of the
   // period it acts on, where the analog law's rotation is on average.
-  record_.i_cmd_A_A = double(i_command.x());
-  record_.i_cmd_B_A = double(i_command.y());
+  record_.i_cmd_A_A = i_command.x();
+  record_.i_cmd_B_A = i_command.y();
   if (config_.current_source) {
     if (!finite(i_command)) trip(FaultCode::non_finite, k);
     if (machine_.state() != DriveState::fault && hw_.current_source != nullptr) {
-      hw_.current_source->set_current_AB_A(double(i_command.x()), double(i_command.y()));
+      hw_.current_source->set_current_AB_A(i_command.x(), i_command.y());
       hw_.pwm.enable();
     }
   } else if (config_.analog_inner_loop) {
     if (!finite(v)) trip(FaultCode::non_finite, k);
     if (machine_.state() != DriveState::fault && hw_.analog_inner_loop != nullptr) {
-      hw_.analog_inner_loop->set_input_AB_V(double(v.x()), double(v.y()));
+      hw_.analog_inner_loop->set_input_AB_V(v.x(), v.y());
       hw_.pwm.enable();
     }
   } else {
     const Vec2 compensation = compensation_AB(x);
     const auto rotation = control::Rotation<T>::from_angle(
-        pole_pairs_ * (x.theta_mech_rad + x.omega_mech_rad_s * T(config_.sample_period_s / 2)));
+        pole_pairs_ * (x.theta_mech_rad + x.omega_mech_rad_s * limits_.half_period_s));
     const Vec2 u_alphabeta = rotation.apply(compensation + v);
     const control::SvpwmResult<T> pwm = control::svpwm(u_alphabeta, v_bus_V);
     record_.voltage_clipped = pwm.clipped;
@@ -414,8 +437,8 @@ control::Vec2<T> Drive<T>::control(uint64_t k, const Estimate& e, T v_bus_V) noe
       v = rotation.apply_inverse(u_alphabeta * (magnitude > limit ? limit / magnitude : T(1))) -
           compensation;
     }
-    record_.u_alpha_V = double(u_alphabeta.x());
-    record_.u_beta_V = double(u_alphabeta.y());
+    record_.u_alpha_V = u_alphabeta.x();
+    record_.u_beta_V = u_alphabeta.y();
     if (!finite(u_alphabeta) || !finite(v)) trip(FaultCode::non_finite, k);
     if (machine_.state() != DriveState::fault) {
       hw_.pwm.set_duties({float(pwm.duty[0]), float(pwm.duty[1]), float(pwm.duty[2])});
@@ -427,7 +450,7 @@ control::Vec2<T> Drive<T>::control(uint64_t k, const Estimate& e, T v_bus_V) noe
 
   // --- a stop is complete once the ramp is at zero and the motor (nearly) still.
   if (stopping && ((speed_ramp_.value() == T(0) &&
-                    std::abs(e.x.omega_mech_rad_s) < T(config_.stop_speed_rad_s)) ||
+                    std::abs(e.x.omega_mech_rad_s) < limits_.stop_speed_rad_s) ||
                    k - stop_start_tick_ > stop_timeout_ticks_)) {
     pwm_off();
     machine_.go(DriveState::idle, TransitionReason::stopped, k);
@@ -451,7 +474,7 @@ void Drive<T>::on_tick() noexcept {
   if (!enable_input_ && modulating()) trip(FaultCode::enable_input, k);
   const T v_bus_V = T(sample.bus_code) * T(hw_.adc.scale().bus_V_per_code);
   if (machine_.state() == DriveState::calibrating) {
-    record_.v_bus_V = double(v_bus_V);
+    record_.v_bus_V = v_bus_V;
     if (calibrate_adc(sample)) {
       calibrated_ = true;
       machine_.go(DriveState::idle, TransitionReason::calibrated, k);
@@ -461,7 +484,7 @@ void Drive<T>::on_tick() noexcept {
     // A fault before the offsets were known: nothing can be measured; clear_faults
     // calibrates again.
     hw_.pwm.disable();
-    record_.v_bus_V = double(v_bus_V);
+    record_.v_bus_V = v_bus_V;
   } else {
     // --- sense, estimate, check
     const Estimate e = estimate(sample);
@@ -471,13 +494,13 @@ void Drive<T>::on_tick() noexcept {
       v = control(k, e, v_bus_V);
     } else {
       if (hw_.pwm.enabled()) pwm_off();
-      record_.u_alpha_V = record_.u_beta_V = 0.0;
+      record_.u_alpha_V = record_.u_beta_V = T(0);
       u_written_V_ = Vec2::Zero();
       // Telemetry shows what the drive would aim at once enabled.
-      const Reference ref = references_.at_tick(k);
+      const Reference<T> ref = references_.at_tick(k);
       record_.omega_ref_rad_s = ref.omega_mech_rad_s;
       record_.flux2_ref_Wb2 = ref.flux2_Wb2;
-      record_.controlled_flux2_ref_Wb2 = double(magnetized_flux2_ref(ref));
+      record_.controlled_flux2_ref_Wb2 = magnetized_flux2_ref(ref);
     }
     if (!hw_.pwm.enabled()) v = Vec2::Zero();
 
@@ -488,18 +511,18 @@ void Drive<T>::on_tick() noexcept {
     load_estimator_.update(e.x.omega_mech_rad_s, e.x.i_s_AB_A, e.x.flux_r_AB_Wb, acting);
     v_in_flight_V_ = v;
 
-    record_.omega_est_rad_s = double(e.x.omega_mech_rad_s);
-    record_.theta_est_rad = double(e.x.theta_mech_rad);
-    record_.flux_est_A_Wb = double(e.x.flux_r_AB_Wb.x());
-    record_.flux_est_B_Wb = double(e.x.flux_r_AB_Wb.y());
-    record_.flux2_est_Wb2 = double(e.x.flux_r_AB_Wb.squaredNorm());
-    record_.controlled_flux2_Wb2 = double(magnetized_flux2(e.x));
-    record_.load_est_Nm = double(e.load_Nm);
-    record_.i_A_A = double(e.x.i_s_AB_A.x());
-    record_.i_B_A = double(e.x.i_s_AB_A.y());
-    record_.v_bus_V = double(v_bus_V);
-    record_.v_A_V = double(v.x());
-    record_.v_B_V = double(v.y());
+    record_.omega_est_rad_s = e.x.omega_mech_rad_s;
+    record_.theta_est_rad = e.x.theta_mech_rad;
+    record_.flux_est_A_Wb = e.x.flux_r_AB_Wb.x();
+    record_.flux_est_B_Wb = e.x.flux_r_AB_Wb.y();
+    record_.flux2_est_Wb2 = e.x.flux_r_AB_Wb.squaredNorm();
+    record_.controlled_flux2_Wb2 = magnetized_flux2(e.x);
+    record_.load_est_Nm = e.load_Nm;
+    record_.i_A_A = e.x.i_s_AB_A.x();
+    record_.i_B_A = e.x.i_s_AB_A.y();
+    record_.v_bus_V = v_bus_V;
+    record_.v_A_V = v.x();
+    record_.v_B_V = v.y();
   }
   const uint64_t exec_ns = hw_.timer.execution_clock_ns() - start_ns;
   record_.exec_ns = static_cast<uint32_t>(std::min<uint64_t>(exec_ns, UINT32_MAX));

@@ -61,8 +61,8 @@ class Drive final : public hal::TickHandler {
   /// Wires the drive; no allocation after this. `references` is used unless the config takes
   /// them from CAN commands. `oracle` (simulation only) gives ideal sensors.
   Drive(const control::MotorParameters& motor, const DriveConfig& config,
-        const DrivePeripherals& peripherals, const ReferenceSource& references,
-        const StateOracle* oracle = nullptr);
+        const DrivePeripherals& peripherals, const ReferenceSource<T>& references,
+        const StateOracle<T>* oracle = nullptr);
 
   void on_tick() noexcept override;
   /// For a program that stops the drive (Linux: Ctrl-C, SIGTERM), after the last tick: turns the
@@ -77,7 +77,7 @@ class Drive final : public hal::TickHandler {
   const StateMachine& state_machine() const noexcept { return machine_; }
   const protocol::CommandDecoder& commands() const noexcept { return decoder_; }
   const Telemetry& telemetry() const noexcept { return telemetry_; }
-  const TickRecord& record() const noexcept { return record_; }
+  const TickRecord<T>& record() const noexcept { return record_; }
   const ExecutionStats& execution() const noexcept { return execution_; }
 
  private:
@@ -105,10 +105,10 @@ class Drive final : public hal::TickHandler {
   /// The magnetizing current: along the flux (the A axis while there is none), of the size that
   /// holds the reference flux in steady state (rotor flux for the DSMC, stator flux for the IOL).
   Vec2 magnetizing_current(const control::RotorFrameState<T>& x,
-                           const Reference& ref) const noexcept;
+                           const Reference<T>& ref) const noexcept;
   /// The squared flux the start-up waits for, and its reference.
   T magnetized_flux2(const control::RotorFrameState<T>& x) const noexcept;
-  T magnetized_flux2_ref(const Reference& ref) const noexcept;
+  T magnetized_flux2_ref(const Reference<T>& ref) const noexcept;
   Vec2 compensation_AB(const control::RotorFrameState<T>& x) const noexcept;
   /// Turns the PWM off and latches the fault (the first one keeps its code and time).
   void trip(FaultCode code, uint64_t k, uint8_t detail = 0) noexcept;
@@ -120,11 +120,22 @@ class Drive final : public hal::TickHandler {
   bool modulating() const noexcept;
   T electromagnetic_torque_Nm(const control::RotorFrameState<T>& x) const noexcept;
 
+  /// The configuration values the tick uses, in the tick's arithmetic (converted once).
+  struct Limits {
+    T adc_offset_limit_A, modulation_margin, current_limit_A, magnetizing_current_A;
+    T magnetizing_current_max_A, magnetized_fraction, half_period_s, stop_speed_rad_s;
+    T overcurrent_A, bus_min_V, bus_max_V, overspeed_rad_s;
+    T command_accel_step_rad_s, stop_accel_step_rad_s;  ///< per period, for the speed ramp
+    bool current_limited;  ///< i_max_A is finite
+  };
+  static Limits limits(const DriveConfig& config) noexcept;
+
   DriveConfig config_;
+  Limits limits_;
   DrivePeripherals hw_;
-  CommandedReference commanded_;
-  const ReferenceSource& references_;  ///< commanded_ or the profile given at construction
-  const StateOracle* oracle_;
+  CommandedReference<T> commanded_;
+  const ReferenceSource<T>& references_;  ///< commanded_ or the profile given at construction
+  const StateOracle<T>* oracle_;
 
   control::ExactModel000Coefficients coefficients_;
   control::ExactModel000<T> model_;
@@ -158,13 +169,13 @@ class Drive final : public hal::TickHandler {
   int64_t calibration_sum_[3] = {0, 0, 0};
   T offset_code_[3] = {T(0), T(0), T(0)};
   uint32_t last_encoder_count_ = 0;
-  int64_t encoder_position_ = 0;       ///< counts within one revolution, [0, cpr)
+  int32_t encoder_position_ = 0;       ///< counts within one revolution, [0, cpr)
   bool encoder_started_ = false;       ///< the first reading has set the observer's angle
   Vec2 v_in_flight_V_ = Vec2::Zero();  ///< written last tick, acts over this period (latency 1)
   T peak_phase_current_A_ = T(0);      ///< largest phase current of this tick
   T phase_current_A_[3] = {T(0), T(0), T(0)};
   bool adc_saturated_ = false;  ///< a phase-current code on a rail this tick
-  TickRecord record_;
+  TickRecord<T> record_;
   ExecutionStats execution_;
 };
 

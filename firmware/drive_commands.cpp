@@ -30,7 +30,7 @@ void Drive<T>::enable(uint64_t k) noexcept {
   if (!machine_.go(DriveState::magnetizing, TransitionReason::enable, k)) return;
   magnetizing_start_tick_ = k;
   last_command_tick_ = k;
-  speed_ramp_.set_max_accel(config_.max_accel_rad_s2, config_.sample_period_s);
+  speed_ramp_.set_max_step(limits_.command_accel_step_rad_s);
   adc_stuck_check_.reset();
   phase_loss_check_.reset();
   encoder_check_.reset();
@@ -69,15 +69,14 @@ protocol::CommandResult Drive<T>::apply(const protocol::Command& c, uint64_t k) 
                  ? CommandResult::accepted
                  : CommandResult::not_allowed;
     case CommandKind::disable:
-      commanded_.set_speed(0.0);           // a later enable waits for a new speed
+      commanded_.set_speed(T(0));           // a later enable waits for a new speed
       if (s == DriveState::magnetizing) {  // no motion to stop yet
         pwm_off();
         machine_.go(DriveState::idle, TransitionReason::disable, k);
       } else if (s == DriveState::running) {
         machine_.go(DriveState::stopping, TransitionReason::disable, k);
         stop_start_tick_ = k;
-        speed_ramp_.set_max_accel(std::min(config_.max_accel_rad_s2, config_.stop_decel_rad_s2),
-                                  config_.sample_period_s);
+        speed_ramp_.set_max_step(limits_.stop_accel_step_rad_s);
       }
       return CommandResult::accepted;
     case CommandKind::clear_faults:
@@ -85,14 +84,14 @@ protocol::CommandResult Drive<T>::apply(const protocol::Command& c, uint64_t k) 
       return CommandResult::accepted;
     case CommandKind::set_speed:
       if (!config_.commands_over_can) return CommandResult::not_allowed;
-      commanded_.set_speed(double(c.value));
+      commanded_.set_speed(T(c.value));
       return CommandResult::accepted;
     case CommandKind::set_flux:
       if (!config_.commands_over_can) return CommandResult::not_allowed;
       if (controller_ == ControllerKind::iol) {
-        commanded_.set_stator_flux2(double(c.value));
+        commanded_.set_stator_flux2(T(c.value));
       } else {
-        commanded_.set_flux2(double(c.value));
+        commanded_.set_flux2(T(c.value));
       }
       return CommandResult::accepted;
     case CommandKind::select_controller: {

@@ -16,6 +16,8 @@ struct ExecutionStats {
     if (ns > max_ns) max_ns = ns;
   }
   double mean_ns() const noexcept { return count ? double(total_ns) / double(count) : 0.0; }
+  /// The mean in whole nanoseconds: integer arithmetic, for the tick (telemetry).
+  uint64_t mean_whole_ns() const noexcept { return count ? total_ns / count : 0; }
 };
 
 }  // namespace imd::firmware

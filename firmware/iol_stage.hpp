@@ -48,7 +48,8 @@ class IolStage {
         outer_speed_loop_(config.outer_speed_loop),
         outer_flux_loop_(config.outer_flux_loop),
         sigma_H_(T(motor.Ls_H - motor.Lm_H * motor.Lm_H / motor.Lr_H)),
-        Lm_over_Lr_(T(motor.Lm_H / motor.Lr_H)) {}
+        Lm_over_Lr_(T(motor.Lm_H / motor.Lr_H)),
+        one_minus_flux_decay_(T(1) - T(coefficients_.flux_decay)) {}
 
   const control::ExactModel001Coefficients& coefficients() const noexcept { return coefficients_; }
   int ticks_per_period() const noexcept { return ticks_per_period_; }
@@ -65,7 +66,7 @@ class IolStage {
   /// One tick while running. `flux_r_AB_Wb` and `omega` are the estimates at this tick;
   /// `ref_next` is the reference for the next T0 boundary.
   IolTickResult<T> tick(const control::Vec2<T>& flux_r_AB_Wb, T omega_mech_rad_s,
-                        const Reference& ref_next) noexcept {
+                        const Reference<T>& ref_next) noexcept {
     IolTickResult<T> r;
     if (ticks_++ % ticks_per_period_ == 0) {
       // A boundary: the current computed one period ago, u(k-1) = i(t_k), is imposed now and
@@ -86,11 +87,11 @@ class IolStage {
     r.y2 = law_.y2(flux_s, flux_s_before_);
     flux_s_before_ = flux_s;
     r.torque_ref_Nm = outer_speed_loop_
-                          ? speed_pi_.step(T(ref_next.omega_mech_rad_s), omega_mech_rad_s)
-                          : T(ref_next.torque_Nm);
-    const T flux2_ref = T(ref_next.stator_flux2_Wb2);
+                          ? speed_pi_.step(ref_next.omega_mech_rad_s, omega_mech_rad_s)
+                          : ref_next.torque_Nm;
+    const T flux2_ref = ref_next.stator_flux2_Wb2;
     r.y2_ref = outer_flux_loop_ ? flux_loop_.step(flux2_ref, r.flux2_s_Wb2)
-                                : (T(1) - T(coefficients_.flux_decay)) * flux2_ref;  // (21)
+                                : one_minus_flux_decay_ * flux2_ref;  // (21)
     const control::IolOutput<T> out = law_.step({flux_s, i_held_, r.torque_ref_Nm, r.y2_ref});
     r.status = out.status;
     r.torque_cmd_Nm = out.torque_cmd_Nm;
@@ -109,6 +110,7 @@ class IolStage {
   int lead_ticks_;  ///< ticks before a boundary at which u(k) is commanded
   bool outer_speed_loop_, outer_flux_loop_;
   T sigma_H_, Lm_over_Lr_;
+  T one_minus_flux_decay_;  ///< 1 - e^{-eta T0}, in T (the tick converts nothing)
   control::Vec2<T> i_held_ = control::Vec2<T>::Zero();  ///< imposed over this period, u(k-1)
   control::Vec2<T> i_next_ = control::Vec2<T>::Zero();  ///< for the next period, u(k)
   control::Vec2<T> flux_s_before_ = control::Vec2<T>::Zero();

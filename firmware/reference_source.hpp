@@ -2,22 +2,29 @@
 /// Where the speed and flux references come from: a scenario profile in simulation, commands
 /// on CAN on a board. The DSMC law needs the reference one step (or, with PWM latency, two
 /// steps) ahead, so references are asked for by tick index.
+/// T is the control arithmetic (float on the MCU): the tick converts nothing.
 #include <cstdint>
 
 namespace imd::firmware {
 
+template <typename T>
 struct Reference {
-  double omega_mech_rad_s = 0.0;
-  double flux2_Wb2 = 0.0;         ///< squared rotor-flux modulus (DSMC)
-  double torque_Nm = 0.0;         ///< torque (IOL without the outer speed loop)
-  double stator_flux2_Wb2 = 0.0;  ///< squared stator-flux modulus (IOL)
+  T omega_mech_rad_s = T(0);
+  T flux2_Wb2 = T(0);         ///< squared rotor-flux modulus (DSMC)
+  T torque_Nm = T(0);         ///< torque (IOL without the outer speed loop)
+  T stator_flux2_Wb2 = T(0);  ///< squared stator-flux modulus (IOL)
 };
 
+template <typename T>
 class ReferenceSource {
+ protected:
+  // Never deleted through the interface (nothing is allocated): no virtual destructor, so
+  // no deleting destructor and no operator delete in the vtables of the firmware.
+  ~ReferenceSource() = default;
+
  public:
-  virtual ~ReferenceSource() = default;
   /// The reference for tick k. Tick context.
-  virtual Reference at_tick(uint64_t k) const noexcept = 0;
+  virtual Reference<T> at_tick(uint64_t k) const noexcept = 0;
 };
 
 }  // namespace imd::firmware

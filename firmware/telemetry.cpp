@@ -12,9 +12,23 @@ using protocol::MessageId;
 Telemetry::Telemetry(uint8_t node_id, uint32_t period_ns, int rate_Hz) noexcept
     : node_id_(node_id),
       period_ns_(period_ns),
-      ticks_per_10Hz_(std::max<uint64_t>(1, 100'000'000ull / period_ns)) {
+      ticks_per_10Hz_(std::max<uint64_t>(1, 100'000'000ull / period_ns)),
+      next_timing_k_(ticks_per_10Hz_ / 2) {
   if (!set_rate_Hz(rate_Hz)) set_rate_Hz(100);
 }
+
+namespace {
+
+/// The next due tick after `due` (<= k) on a schedule of `period` ticks, past k: one step
+/// normally, more after skipped ticks. No division: a 64-bit one is a library call on the MCU.
+uint64_t next_due(uint64_t due, uint64_t k, uint64_t period) noexcept {
+  do {
+    due += period;
+  } while (due <= k);
+  return due;
+}
+
+}  // namespace
 
 bool Telemetry::set_rate_Hz(int rate_Hz) noexcept {
   if (rate_Hz < protocol::kFastTelemetryMinHz || rate_Hz > protocol::kFastTelemetryMaxHz) {
@@ -35,18 +49,24 @@ void Telemetry::send(hal::CanBus& can, const hal::CanFrame& frame) noexcept {
   if (!can.try_send(frame)) ++dropped_;
 }
 
-void Telemetry::publish(uint64_t k, hal::CanBus& can, const TickRecord& r,
+template <typename T>
+void Telemetry::publish(uint64_t k, hal::CanBus& can, const TickRecord<T>& r,
                         const DriveStatus& status, const StateMachine& machine,
                         const ExecutionStats& execution, uint32_t budget_ns) noexcept {
   send_state_changes(can, machine);
-  if (k % ticks_per_10Hz_ == 0) send_heartbeat(can, status, machine);
-  if (k % ticks_per_10Hz_ == ticks_per_10Hz_ / 2) {  // between heartbeats, to spread the load
+  if (k >= next_heartbeat_k_) {
+    send_heartbeat(can, status, machine);
+    next_heartbeat_k_ = next_due(next_heartbeat_k_, k, ticks_per_10Hz_);
+  }
+  if (k >= next_timing_k_) {  // between heartbeats, to spread the load
+    next_timing_k_ = next_due(next_timing_k_, k, ticks_per_10Hz_);
     send(can, encode_frame(node_id_, MessageId::timing,
-                           {float(execution.mean_ns() * 1e-3), float(execution.max_ns) * 1e-3f,
+                           {float(execution.mean_whole_ns()) * 1e-3f, float(execution.max_ns) * 1e-3f,
                             float(std::min<uint64_t>(execution.overruns, 0xFFFF)),
                             float(budget_ns) * 1e-3f}));
   }
-  if (k % fast_period_ticks_ == 0) {
+  if (k >= next_fast_k_) {
+    next_fast_k_ = next_due(next_fast_k_, k, fast_period_ticks_);
     send(can, encode_frame(node_id_, MessageId::telemetry_speed_flux,
                            {float(r.omega_est_rad_s), float(r.omega_ref_rad_s),
                             float(r.controlled_flux2_Wb2), float(r.controlled_flux2_ref_Wb2)}));
@@ -57,6 +77,13 @@ void Telemetry::publish(uint64_t k, hal::CanBus& can, const TickRecord& r,
                            {float(r.u_alpha_V), float(r.u_beta_V), float(sample_count_++)}));
   }
 }
+
+template void Telemetry::publish(uint64_t, hal::CanBus&, const TickRecord<float>&,
+                                 const DriveStatus&, const StateMachine&, const ExecutionStats&,
+                                 uint32_t) noexcept;
+template void Telemetry::publish(uint64_t, hal::CanBus&, const TickRecord<double>&,
+                                 const DriveStatus&, const StateMachine&, const ExecutionStats&,
+                                 uint32_t) noexcept;
 
 void Telemetry::final_heartbeat(hal::CanBus& can, const DriveStatus& status,
                                 const StateMachine& machine) noexcept {

@@ -38,7 +38,9 @@ class Telemetry {
   int rate_Hz() const noexcept { return rate_Hz_; }
 
   /// The cyclic frames due at tick k, and a state_change frame for each new transition.
-  void publish(uint64_t k, hal::CanBus& can, const TickRecord& record, const DriveStatus& status,
+  /// T: the drive's arithmetic (float and double are instantiated).
+  template <typename T>
+  void publish(uint64_t k, hal::CanBus& can, const TickRecord<T>& record, const DriveStatus& status,
                const StateMachine& machine, const ExecutionStats& execution,
                uint32_t budget_ns) noexcept;
   /// A state_change frame for each transition not yet reported, then a heartbeat: the last
@@ -64,6 +66,9 @@ class Telemetry {
   uint32_t period_ns_;
   uint64_t ticks_per_10Hz_;
   uint64_t fast_period_ticks_ = 1;
+  // The ticks at which the cyclic frames are due next (heartbeat at 0, the timing frame
+  // half a heartbeat period later, fast telemetry at 0); a new rate applies from the next.
+  uint64_t next_heartbeat_k_ = 0, next_timing_k_, next_fast_k_ = 0;
   int rate_Hz_ = 100;
   uint8_t heartbeat_count_ = 0;
   uint8_t sample_count_ = 0;

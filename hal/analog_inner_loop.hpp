@@ -8,10 +8,17 @@
 namespace imd::hal {
 
 class AnalogInnerLoop {
+ protected:
+  // Never deleted through the interface (nothing is allocated): no virtual destructor, so
+  // no deleting destructor and no operator delete in the vtables of the firmware.
+  ~AnalogInnerLoop() = default;
+
  public:
-  virtual ~AnalogInnerLoop() = default;
   /// Sets v~ (rotor-aligned frame) for the next period. Tick context.
   virtual void set_input_AB_V(double v_A_V, double v_B_V) noexcept = 0;
+  /// The same from a single-precision drive: the device converts, so that the drive's tick
+  /// converts nothing (the MCU has no double-precision FPU).
+  virtual void set_input_AB_V(float v_A_V, float v_B_V) noexcept = 0;
 };
 
 }  // namespace imd::hal

@@ -12,8 +12,12 @@ struct CanFrame {
 };
 
 class CanBus {
+ protected:
+  // Never deleted through the interface (nothing is allocated): no virtual destructor, so
+  // no deleting destructor and no operator delete in the vtables of the firmware.
+  ~CanBus() = default;
+
  public:
-  virtual ~CanBus() = default;
   /// Queues a frame; false if the transmit queue is full (the frame is dropped and counted by
   /// the caller). Never blocks.
   virtual bool try_send(const CanFrame& frame) noexcept = 0;

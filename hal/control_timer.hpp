@@ -7,14 +7,22 @@ namespace imd::hal {
 
 /// What the timer calls each period.
 class TickHandler {
+ protected:
+  // Never deleted through the interface (nothing is allocated): no virtual destructor, so
+  // no deleting destructor and no operator delete in the vtables of the firmware.
+  ~TickHandler() = default;
+
  public:
-  virtual ~TickHandler() = default;
   virtual void on_tick() noexcept = 0;
 };
 
 class ControlTimer {
+ protected:
+  // Never deleted through the interface (nothing is allocated): no virtual destructor, so
+  // no deleting destructor and no operator delete in the vtables of the firmware.
+  ~ControlTimer() = default;
+
  public:
-  virtual ~ControlTimer() = default;
   /// Starts calling `handler` every period. The handler must outlive the timer's running.
   virtual void start(TickHandler& handler) noexcept = 0;
   virtual void stop() noexcept = 0;

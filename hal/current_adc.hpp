@@ -20,8 +20,12 @@ struct AdcScale {
 };
 
 class CurrentAdc {
+ protected:
+  // Never deleted through the interface (nothing is allocated): no virtual destructor, so
+  // no deleting destructor and no operator delete in the vtables of the firmware.
+  ~CurrentAdc() = default;
+
  public:
-  virtual ~CurrentAdc() = default;
   /// The conversion triggered at the start of this tick. Tick context.
   virtual AdcSample sample() const noexcept = 0;
   virtual AdcScale scale() const noexcept = 0;

@@ -7,10 +7,17 @@
 namespace imd::hal {
 
 class CurrentSource {
+ protected:
+  // Never deleted through the interface (nothing is allocated): no virtual destructor, so
+  // no deleting destructor and no operator delete in the vtables of the firmware.
+  ~CurrentSource() = default;
+
  public:
-  virtual ~CurrentSource() = default;
   /// Sets the rotor-frame stator current from the next period on. Tick context.
   virtual void set_current_AB_A(double i_A_A, double i_B_A) noexcept = 0;
+  /// The same from a single-precision drive: the device converts, so that the drive's tick
+  /// converts nothing (the MCU has no double-precision FPU).
+  virtual void set_current_AB_A(float i_A_A, float i_B_A) noexcept = 0;
 };
 
 }  // namespace imd::hal

@@ -6,8 +6,12 @@
 namespace imd::hal {
 
 class Encoder {
+ protected:
+  // Never deleted through the interface (nothing is allocated): no virtual destructor, so
+  // no deleting destructor and no operator delete in the vtables of the firmware.
+  ~Encoder() = default;
+
  public:
-  virtual ~Encoder() = default;
   /// Counter value latched at the start of the tick. Tick context.
   virtual uint32_t count() const noexcept = 0;
   /// Counts per mechanical revolution (four times the line count for quadrature).

@@ -5,8 +5,12 @@
 namespace imd::hal {
 
 class Gpio {
+ protected:
+  // Never deleted through the interface (nothing is allocated): no virtual destructor, so
+  // no deleting destructor and no operator delete in the vtables of the firmware.
+  ~Gpio() = default;
+
  public:
-  virtual ~Gpio() = default;
   /// Drives an output line. Tick context.
   virtual void write(uint8_t line, bool level) noexcept = 0;
   /// Reads a line. Tick context.

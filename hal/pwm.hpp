@@ -8,8 +8,12 @@ namespace imd::hal {
 using PhaseDuties = std::array<float, 3>;  ///< phases a, b, c
 
 class Pwm {
+ protected:
+  // Never deleted through the interface (nothing is allocated): no virtual destructor, so
+  // no deleting destructor and no operator delete in the vtables of the firmware.
+  ~Pwm() = default;
+
  public:
-  virtual ~Pwm() = default;
   /// Latches duties for the next carrier period. Tick context.
   virtual void set_duties(const PhaseDuties& duty) noexcept = 0;
   /// Starts switching with the last duties written. Tick context.

@@ -1,6 +1,7 @@
 #include "hal_sim/fault_injection.hpp"
 
 #include <array>
+#include <cmath>
 #include <utility>
 
 namespace imd::sim {
@@ -24,6 +25,33 @@ const char* fault_kind_name(FaultKind kind) noexcept {
     if (k == kind) return name;
   }
   return "unknown";
+}
+
+const char* fault_parameter_error(const FaultInjection& fault) noexcept {
+  const auto positive_finite = [](double value) { return value > 0.0 && std::isfinite(value); };
+  const bool phase_ok = fault.phase >= 0 && fault.phase <= 2;
+  switch (fault.kind) {
+    case FaultKind::overcurrent:
+      if (!phase_ok) return "overcurrent: phase must be 0, 1 or 2";
+      if (!positive_finite(fault.surge_A)) return "overcurrent: surge_A must be > 0 and finite";
+      return nullptr;
+    case FaultKind::overvoltage:
+      return positive_finite(fault.bus_V) ? nullptr : "overvoltage: bus_V must be > 0 and finite";
+    case FaultKind::undervoltage:
+      return positive_finite(fault.bus_V) ? nullptr : "undervoltage: bus_V must be > 0 and finite";
+    case FaultKind::phase_loss:
+      return phase_ok ? nullptr : "phase_loss: phase must be 0, 1 or 2";
+    case FaultKind::overrun:
+      // The bound keeps the stall in nanoseconds far inside uint64_t.
+      return fault.stall_us > 0.0 && fault.stall_us < 1e9
+                 ? nullptr
+                 : "overrun: stall_us must be > 0 and below 1e9";
+    case FaultKind::encoder_loss:
+    case FaultKind::adc_stuck:
+    case FaultKind::can_silence:
+      return nullptr;
+  }
+  return "unknown fault kind";
 }
 
 std::optional<FaultKind> parse_fault_kind(std::string_view name) {

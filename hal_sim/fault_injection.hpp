@@ -52,4 +52,10 @@ struct FaultInjection {
   double stall_us = 1000.0;                                 ///< overrun: time stolen per tick
 };
 
+/// Why SimBoard::inject would refuse this fault: a static message naming the kind and the
+/// parameter out of its range (phase outside 0..2; a surge or bus that is not > 0 and finite; a
+/// stall not in (0, 1e9) us), e.g. "overcurrent: surge_A must be > 0 and finite". nullptr when
+/// the fault is valid.
+const char* fault_parameter_error(const FaultInjection& fault) noexcept;
+
 }  // namespace imd::sim

@@ -14,7 +14,7 @@ double LoadProfile::at(double t_s) const noexcept {
     }
     case Kind::steps: {
       double value = 0.0;
-      for (std::size_t i = 0; i < times_s.size() && times_s[i] <= t_s; ++i) value = values_Nm[i];
+      for (std::size_t i = 0; i < step_count && times_s[i] <= t_s; ++i) value = values_Nm[i];
       return value;
     }
   }

@@ -2,10 +2,11 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <functional>
 #include <limits>
-#include <numbers>
 #include <set>
 #include <sstream>
 
@@ -14,15 +15,6 @@
 #include "hal_sim/scenario_reader.hpp"
 
 namespace imd::sim {
-
-double SpeedProfile::at(double t_s) const noexcept {
-  if (kind == Kind::sine) {
-    return offset_rad_s + amplitude_rad_s * std::sin(2.0 * std::numbers::pi * frequency_Hz * t_s);
-  }
-  double value = 0.0;
-  for (std::size_t i = 0; i < times_s.size() && times_s[i] <= t_s; ++i) value = values_rad_s[i];
-  return value;
-}
 
 namespace {
 
@@ -74,13 +66,25 @@ void apply_override(toml::table& doc, const std::string& assignment, const std::
   table->insert_or_assign(parts.back(), std::move(*parsed.get("value")));
 }
 
-/// A steps table: times in increasing order, one value per time.
-void read_steps(Reader& r, std::string_view times_key, std::string_view values_key,
-                std::vector<double>& times, std::vector<double>& values) {
-  times = r.numbers(times_key);
-  values = r.numbers(values_key);
-  if (times.size() != values.size()) r.fail(values_key, "must have as many entries as the times");
-  if (!std::is_sorted(times.begin(), times.end())) r.fail(times_key, "must be in increasing order");
+/// A steps table: times in increasing order, one value per time, at most N steps (the profiles
+/// hold them in fixed storage). Returns the number of steps.
+template <std::size_t N>
+std::size_t read_steps(Reader& r, std::string_view times_key, std::string_view values_key,
+                       std::array<double, N>& times, std::array<double, N>& values) {
+  const std::vector<double> read_times = r.numbers(times_key);
+  const std::vector<double> read_values = r.numbers(values_key);
+  if (read_times.size() != read_values.size()) {
+    r.fail(values_key, "must have as many entries as the times");
+  }
+  if (read_times.size() > N) {
+    r.fail(times_key, fmt::format("has {} entries: must have at most {}", read_times.size(), N));
+  }
+  if (!std::is_sorted(read_times.begin(), read_times.end())) {
+    r.fail(times_key, "must be in increasing order");
+  }
+  std::copy(read_times.begin(), read_times.end(), times.begin());
+  std::copy(read_values.begin(), read_values.end(), values.begin());
+  return read_times.size();
 }
 
 void read_speed_reference(Reader& r, Scenario& s) {
@@ -93,8 +97,8 @@ void read_speed_reference(Reader& r, Scenario& s) {
     s.speed.offset_rad_s = r.number("reference.speed.offset_rad_s", 0.0);
   } else {
     s.speed.kind = SpeedProfile::Kind::steps;
-    read_steps(r, "reference.speed.times_s", "reference.speed.values_rad_s", s.speed.times_s,
-               s.speed.values_rad_s);
+    s.speed.step_count = read_steps(r, "reference.speed.times_s", "reference.speed.values_rad_s",
+                                    s.speed.times_s, s.speed.values_rad_s);
   }
 }
 
@@ -113,7 +117,7 @@ void read_load_like(Reader& r, const std::string& prefix, LoadProfile& p) {
     p.period_s = r.positive(key("period_s"), std::nullopt);
   } else {
     p.kind = LoadProfile::Kind::steps;
-    read_steps(r, key("times_s"), key("values_Nm"), p.times_s, p.values_Nm);
+    p.step_count = read_steps(r, key("times_s"), key("values_Nm"), p.times_s, p.values_Nm);
   }
 }
 

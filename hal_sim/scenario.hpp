@@ -13,16 +13,9 @@
 #include "hal_sim/fault_injection.hpp"
 #include "hal_sim/load_profile.hpp"
 #include "hal_sim/sim_board.hpp"
+#include "hal_sim/speed_profile.hpp"
 
 namespace imd::sim {
-
-struct SpeedProfile {
-  enum class Kind { sine, steps };
-  Kind kind = Kind::sine;
-  double amplitude_rad_s = 0.0, frequency_Hz = 0.0, offset_rad_s = 0.0;  ///< sine
-  std::vector<double> times_s, values_rad_s;  ///< steps: values_rad_s[i] from times_s[i]; 0 before
-  double at(double t_s) const noexcept;
-};
 
 /// A command the host sends the drive over CAN, as the scenario writes it ([[can_commands]]).
 /// Generic: the message and field names are checked and encoded by the runner against the

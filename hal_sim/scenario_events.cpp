@@ -82,10 +82,15 @@ FaultInjection read_fault(Reader& r, const std::string& base, const toml::table&
     }
     case FaultKind::overrun:
       fault.stall_us = r.positive(key("stall_us"), 1000.0);
+      if (!(fault.stall_us < 1e9)) {
+        r.fail(key("stall_us"), fmt::format("= {}: must be below 1e9 us", fault.stall_us));
+      }
       break;
     default:
       break;
   }
+  // The board refuses what it cannot apply; the checks above name the key first.
+  if (const char* error = fault_parameter_error(fault)) r.fail(base, error);
   return fault;
 }
 

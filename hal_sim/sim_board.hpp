@@ -11,8 +11,10 @@
 /// plant); the PWM enable still gates it.
 ///
 /// Faults (hal_sim/fault_injection.hpp) are injected with inject(), between ticks.
+///
+/// No heap, no exceptions: the board also builds for the MCU of a processor-in-the-loop run.
+#include <cstddef>
 #include <cstdint>
-#include <vector>
 
 #include "control/motor_parameters.hpp"
 #include "hal_sim/fault_injection.hpp"
@@ -60,7 +62,7 @@ class SimBoard {
   const InductionMotorPlant& plant() const noexcept { return plant_; }
   const SimBoardConfig& config() const noexcept { return config_; }
 
-  void set_load_profile(const LoadProfile& profile) { load_ = profile; }
+  void set_load_profile(const LoadProfile& profile) noexcept { load_ = profile; }
   /// Load torque over the current period (held, hypothesis H1).
   double load_Nm() const noexcept { return load_.at(plant_.time_s()); }
   /// Stator voltage the plant saw over the last period (alpha-beta); for the analog device, the
@@ -82,11 +84,11 @@ class SimBoard {
   void end_period();
 
   /// Applies a fault at once (FaultKind documents each); it lasts to the end of the run. Call
-  /// between ticks: the next run_tick() sees it. Throws std::invalid_argument on a parameter
-  /// out of its range (phase outside 0..2, a non-positive or NaN surge, bus or stall).
-  void inject(const FaultInjection& fault);
-  /// The faults injected so far, in order.
-  const std::vector<FaultInjection>& injected() const noexcept { return injected_; }
+  /// between ticks: the next run_tick() sees it. Returns false and changes nothing when a
+  /// parameter is out of its range (fault_parameter_error says which).
+  [[nodiscard]] bool inject(const FaultInjection& fault) noexcept;
+  /// How many faults inject() has applied.
+  std::size_t injected_count() const noexcept { return injected_count_; }
   /// The DC bus now: config().v_bus_V until a bus fault changes it.
   double v_bus_V() const noexcept { return v_bus_V_; }
   bool encoder_frozen() const noexcept { return encoder_frozen_; }
@@ -117,7 +119,7 @@ class SimBoard {
   double v_bus_V_;
   bool encoder_frozen_ = false;
   bool adc_stuck_ = false;
-  std::vector<FaultInjection> injected_;
+  std::size_t injected_count_ = 0;
 };
 
 }  // namespace imd::sim

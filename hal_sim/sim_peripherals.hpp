@@ -1,9 +1,9 @@
 #pragma once
 /// The simulated board's peripherals: each implements one HAL interface over state that the
 /// board (SimBoard) updates in lock-step. They hold no physics of their own.
+#include <array>
+#include <cstddef>
 #include <cstdint>
-#include <deque>
-#include <vector>
 
 #include "hal/analog_inner_loop.hpp"
 #include "hal/can_bus.hpp"
@@ -56,20 +56,48 @@ class SimAdc final : public hal::CurrentAdc {
   hal::AdcSample sample_{};
 };
 
+/// A bounded FIFO of CAN frames in fixed storage. Single-threaded: the simulation and the
+/// firmware run in one thread (hal::SpscRing's atomics and cache-line alignment would only
+/// cost RAM on the MCU).
+template <std::size_t Capacity>
+class CanFrameQueue {
+ public:
+  /// False if full (the frame is not queued).
+  bool push(const hal::CanFrame& frame) noexcept {
+    if (size_ == Capacity) return false;
+    frames_[(head_ + size_) % Capacity] = frame;
+    ++size_;
+    return true;
+  }
+  /// The oldest frame into `frame`; false if empty.
+  bool pop(hal::CanFrame& frame) noexcept {
+    if (size_ == 0) return false;
+    frame = frames_[head_];
+    head_ = (head_ + 1) % Capacity;
+    --size_;
+    return true;
+  }
+
+ private:
+  std::array<hal::CanFrame, Capacity> frames_{};
+  std::size_t head_ = 0;  ///< index of the oldest frame
+  std::size_t size_ = 0;
+};
+
 /// A CAN bus whose far end is the simulation: frames sent are collected for logging, frames
-/// injected arrive in order. Bounded queues, like a controller's mailboxes.
+/// injected arrive in order. Bounded queues, like a controller's mailboxes, in fixed storage.
 class SimCan final : public hal::CanBus {
  public:
-  static constexpr std::size_t kQueueDepth = 64;
+  static constexpr std::size_t kQueueDepth = 64;  ///< frames each way
+  /// False when kQueueDepth sent frames are waiting for take_sent().
   bool try_send(const hal::CanFrame& frame) noexcept override;
   bool try_receive(hal::CanFrame& frame) noexcept override;
   /// Simulation side: deliver a frame to the firmware; false if it did not arrive (the receive
   /// queue is full, or the bus is silenced).
-  bool inject(const hal::CanFrame& frame);
-  /// Simulation side: take the frames the firmware sent since the last call.
-  std::deque<hal::CanFrame> take_sent();
-  /// The same, into `out` (cleared first): no allocation once `out` has grown.
-  void take_sent(std::vector<hal::CanFrame>& out);
+  bool inject(const hal::CanFrame& frame) noexcept;
+  /// Simulation side: takes the oldest frame the firmware sent into `out`; false if none is
+  /// left. (hal_sim/sim_can_host.hpp takes them all into a vector on the host.)
+  bool take_sent(hal::CanFrame& out) noexcept { return sent_.pop(out); }
 
   /// Fault: from now on every injected frame is lost (the host side falls silent). Frames
   /// already received stay; the firmware's sent frames are still collected.
@@ -79,7 +107,7 @@ class SimCan final : public hal::CanBus {
   uint64_t dropped_frames() const noexcept { return dropped_; }
 
  private:
-  std::deque<hal::CanFrame> sent_, received_;
+  CanFrameQueue<kQueueDepth> sent_, received_;
   bool silenced_ = false;
   uint64_t dropped_ = 0;
 };
@@ -97,7 +125,8 @@ class SimGpio final : public hal::Gpio {
 };
 
 /// Lock-step timer: the board calls the handler once per simulated period. The execution clock
-/// is the host's monotonic clock, plus any time a stall (an overrun fault) has stolen.
+/// is host_clock_ns() (hal_sim/host_clock.hpp), plus any time a stall (an overrun fault) has
+/// stolen.
 class SimTimer final : public hal::ControlTimer {
  public:
   explicit SimTimer(uint32_t period_ns) : period_ns_(period_ns) {}
@@ -133,6 +162,9 @@ class SimAnalogInnerLoop final : public hal::AnalogInnerLoop {
     v_A_V_ = v_A_V;
     v_B_V_ = v_B_V;
   }
+  void set_input_AB_V(float v_A_V, float v_B_V) noexcept override {
+    set_input_AB_V(double(v_A_V), double(v_B_V));
+  }
   double v_A_V() const noexcept { return v_A_V_; }
   double v_B_V() const noexcept { return v_B_V_; }
 
@@ -146,6 +178,9 @@ class SimCurrentSource final : public hal::CurrentSource {
   void set_current_AB_A(double i_A_A, double i_B_A) noexcept override {
     i_A_A_ = i_A_A;
     i_B_A_ = i_B_A;
+  }
+  void set_current_AB_A(float i_A_A, float i_B_A) noexcept override {
+    set_current_AB_A(double(i_A_A), double(i_B_A));
   }
   double i_A_A() const noexcept { return i_A_A_; }
   double i_B_A() const noexcept { return i_B_A_; }

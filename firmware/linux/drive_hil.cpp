@@ -38,6 +38,7 @@
 #include "hal/linux/queued_can_bus.hpp"
 #include "hal/linux/realtime_timer.hpp"
 #include "hal_sim/config_error.hpp"
+#include "hal_sim/fault_injection.hpp"
 #include "hal_sim/scenario.hpp"
 #include "hal_sim/sim_board.hpp"
 
@@ -129,7 +130,7 @@ int run(const Options& o, const imd::sim::Scenario& s, imd::hal::QueuedCanBus* c
   timing.fifo_priority = o.priority;
   timing.cpu = o.cpu;
   hal::RealtimeTimer timer(timing);
-  const firmware::ScenarioReferences references(s);
+  const firmware::ScenarioReferences<T> references(s);
   firmware::Drive<T> drive(s.motor, config,
                            {board.pwm(), board.encoder(), board.adc(), timer,
                             &board.analog_inner_loop(), &board.current_source(), can, gpio},
@@ -228,13 +229,14 @@ int main(int argc, char** argv) {
   imd::sim::Scenario scenario;
   try {
     scenario = imd::sim::load_scenario(o.scenario, o.overrides);
-    // The faults are checked here, on a board of their own: the tick must not throw.
-    imd::sim::SimBoard probe(scenario.motor, imd::firmware::board_config(scenario));
-    for (const imd::sim::FaultInjection& fault : scenario.faults) probe.inject(fault);
   } catch (const imd::sim::ConfigError& error) {
     return fail(error.what());
-  } catch (const std::invalid_argument& error) {
-    return fail(o.scenario + ": " + error.what());
+  }
+  // The faults are checked here, before the loop: in the tick the board would skip them.
+  for (const imd::sim::FaultInjection& fault : scenario.faults) {
+    if (const char* error = imd::sim::fault_parameter_error(fault)) {
+      return fail(o.scenario + ": " + error);
+    }
   }
   std::vector<std::string> warnings;
   const bool with_can = o.can != "none";

@@ -17,14 +17,15 @@ namespace imd::firmware {
 template <typename T>
 class HilTick final : public hal::TickHandler {
  public:
-  /// `faults` sorted by time and already validated (SimBoard::inject must not throw here).
+  /// `faults` sorted by time and already validated (fault_parameter_error): the board would
+  /// skip an invalid one.
   HilTick(sim::SimBoard& board, Drive<T>& drive, std::vector<sim::FaultInjection> faults)
       : board_(board), drive_(drive), faults_(std::move(faults)) {}
 
   void on_tick() noexcept override {
     const double t_s = double(ticks_) * board_.config().period_s;
     for (; next_fault_ < faults_.size() && faults_[next_fault_].at_s <= t_s + 1e-12; ++next_fault_) {
-      board_.inject(faults_[next_fault_]);
+      if (!board_.inject(faults_[next_fault_])) ++rejected_faults_;
     }
     board_.begin_period();
     drive_.on_tick();
@@ -35,13 +36,14 @@ class HilTick final : public hal::TickHandler {
   }
 
   bool plant_diverged() const noexcept { return diverged_.load(); }
-  std::size_t faults_injected() const noexcept { return next_fault_; }
+  std::size_t faults_injected() const noexcept { return next_fault_ - rejected_faults_; }
 
  private:
   sim::SimBoard& board_;
   Drive<T>& drive_;
   std::vector<sim::FaultInjection> faults_;
   std::size_t next_fault_ = 0;
+  std::size_t rejected_faults_ = 0;  ///< refused by the board (none once validated)
   uint64_t ticks_ = 0;
   std::atomic<bool> diverged_{false};
 };

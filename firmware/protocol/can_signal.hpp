@@ -63,13 +63,25 @@ inline float get_physical(const Payload& data, const Signal& s) noexcept {
   return float(get_raw(data, s)) * float(s.scale_num) / float(s.scale_den) + s.offset;
 }
 
+/// A whole-valued float as an integer with single-precision conversions only: on the MCU a
+/// direct float-to-int64 cast is a library call that computes in double.
+inline int64_t float_to_int64(float whole) noexcept {
+  constexpr float k2p31 = 2147483648.0f, k2p32 = 4294967296.0f;
+  if (whole >= -k2p31 && whole < k2p31) return static_cast<int32_t>(whole);
+  if (whole >= 0.0f && whole < k2p32) return static_cast<int64_t>(static_cast<uint32_t>(whole));
+  // Beyond 2^32 a float's spacing is at least 512: both parts below are exact.
+  const float high = std::floor(whole / k2p32);
+  const auto low = static_cast<uint32_t>(whole - high * k2p32);
+  return int64_t{static_cast<int32_t>(high)} * (int64_t{1} << 32) + int64_t{low};
+}
+
 /// The nearest raw value for a physical value, saturated to the signal's range. A NaN becomes
 /// raw_min: telemetry must never wrap around to a plausible value.
 inline int64_t to_raw(const Signal& s, float value) noexcept {
   const float raw = std::round((value - s.offset) * float(s.scale_den) / float(s.scale_num));
   if (!(raw >= float(s.raw_min()))) return s.raw_min();  // NaN and -Inf too
   if (raw >= float(s.raw_max())) return s.raw_max();
-  return static_cast<int64_t>(raw);
+  return float_to_int64(raw);
 }
 
 inline void set_physical(Payload& data, const Signal& s, float value) noexcept {

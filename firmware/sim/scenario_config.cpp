@@ -87,9 +87,8 @@ void prepare_board(sim::SimBoard& board, const sim::Scenario& s) {
   board.plant().set_state(start);
 }
 
-Reference ScenarioReferences::at_tick(uint64_t k) const noexcept {
-  const double t_s = double(k) * s_.sample_period_s;
-  return {s_.speed.at(t_s), s_.flux2_Wb2, s_.torque.at(t_s), s_.stator_flux2_Wb2};
+ScenarioProfiles profiles(const sim::Scenario& s) {
+  return {s.speed, s.flux2_Wb2, s.torque, s.stator_flux2_Wb2};
 }
 
 }  // namespace imd::firmware

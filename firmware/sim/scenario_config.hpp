@@ -6,6 +6,7 @@
 
 #include "firmware/drive_config.hpp"
 #include "firmware/reference_source.hpp"
+#include "firmware/sim/scenario_profiles.hpp"
 #include "hal_sim/scenario.hpp"
 #include "hal_sim/sim_board.hpp"
 
@@ -23,14 +24,23 @@ void prepare_board(sim::SimBoard& board, const sim::Scenario& s);
 /// the scenario sets one (the host's wall-clock time per tick is not the MCU's).
 DriveConfig drive_config(const sim::Scenario& s);
 
-/// The scenario's speed, flux and torque profiles as the drive's reference source.
-class ScenarioReferences final : public ReferenceSource {
+/// The scenario's speed, flux and torque profiles.
+ScenarioProfiles profiles(const sim::Scenario& s);
+
+/// The scenario's profiles as the reference source of a drive of arithmetic T: evaluated in
+/// double at each tick's time, then rounded to T.
+template <typename T>
+class ScenarioReferences final : public ReferenceSource<T> {
  public:
-  explicit ScenarioReferences(const sim::Scenario& s) : s_(s) {}
-  Reference at_tick(uint64_t k) const noexcept override;
+  explicit ScenarioReferences(const sim::Scenario& s)
+      : profiles_(profiles(s)), period_s_(s.sample_period_s) {}
+  Reference<T> at_tick(uint64_t k) const noexcept override {
+    return reference_at_tick<T>(profiles_, period_s_, k);
+  }
 
  private:
-  const sim::Scenario& s_;
+  ScenarioProfiles profiles_;
+  double period_s_;
 };
 
 }  // namespace imd::firmware

@@ -58,7 +58,7 @@ class GpiodLines final : public Gpio {
                                           const std::string& consumer, std::string& error);
 
   /// Drives the outputs to their inactive level (logical 0), releases the lines, closes the chip.
-  ~GpiodLines() override;
+  ~GpiodLines();
   GpiodLines(const GpiodLines&) = delete;
   GpiodLines& operator=(const GpiodLines&) = delete;
 

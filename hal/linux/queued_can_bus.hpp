@@ -42,7 +42,7 @@ class QueuedCanBus final : public CanBus {
   static std::unique_ptr<QueuedCanBus> open(const std::string& iface, std::string& error,
                                             const std::vector<CanIdFilter>& filters = {});
   /// Stops the I/O thread after it has sent what is queued (up to 100 ms).
-  ~QueuedCanBus() override;
+  ~QueuedCanBus();
   QueuedCanBus(const QueuedCanBus&) = delete;
   QueuedCanBus& operator=(const QueuedCanBus&) = delete;
 

@@ -55,7 +55,7 @@ uint64_t monotonic_ns() noexcept;
 class RealtimeTimer final : public ControlTimer {
  public:
   explicit RealtimeTimer(const RealtimeOptions& options) : options_(options) {}
-  ~RealtimeTimer() override { stop(); }
+  ~RealtimeTimer() { stop(); }
   RealtimeTimer(const RealtimeTimer&) = delete;
   RealtimeTimer& operator=(const RealtimeTimer&) = delete;
 

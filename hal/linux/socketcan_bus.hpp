@@ -51,7 +51,7 @@ class SocketCanBus final : public CanBus {
   static std::unique_ptr<SocketCanBus> open(const std::string& iface, std::string& error,
                                             const std::vector<CanIdFilter>& filters = {});
 
-  ~SocketCanBus() override;
+  ~SocketCanBus();
   SocketCanBus(const SocketCanBus&) = delete;
   SocketCanBus& operator=(const SocketCanBus&) = delete;
 

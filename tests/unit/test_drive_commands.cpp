@@ -17,8 +17,8 @@ using protocol::CommandKind;
 using protocol::CommandResult;
 using protocol::MessageId;
 
-struct NoProfile final : ReferenceSource {
-  Reference at_tick(uint64_t) const noexcept override { return {}; }
+struct NoProfile final : ReferenceSource<double> {
+  Reference<double> at_tick(uint64_t) const noexcept override { return {}; }
 };
 
 /// The paper-000 motor on a realistic board, commanded over CAN as node 1.
@@ -58,7 +58,7 @@ struct CanRig {
   void run(int ticks) {
     for (int k = 0; k < ticks; ++k) {
       board.run_tick();
-      for (const hal::CanFrame& f : board.can_side().take_sent()) sent.push_back(f);
+      for (hal::CanFrame f; board.can_side().take_sent(f);) sent.push_back(f);
     }
   }
   /// The results of the command_ack frames sent so far.
@@ -276,7 +276,7 @@ TEST(DriveCommands, ShutDownTurnsThePwmOffAndSendsAFinalHeartbeatInIdle) {
   ASSERT_TRUE(rig.board.pwm().enabled());
   rig.sent.clear();
   rig.drive.shut_down(rig.board.timer().tick_count());
-  for (const hal::CanFrame& f : rig.board.can_side().take_sent()) rig.sent.push_back(f);
+  for (hal::CanFrame f; rig.board.can_side().take_sent(f);) rig.sent.push_back(f);
   EXPECT_FALSE(rig.board.pwm().enabled());
   EXPECT_EQ(rig.drive.state(), DriveState::idle);
   // The state_change (magnetizing -> idle, shutdown), then the heartbeat saying idle.

@@ -33,8 +33,11 @@ void operator delete(void* p, std::size_t) noexcept {
 namespace imd::firmware {
 namespace {
 
-struct Constant final : ReferenceSource {
-  Reference at_tick(uint64_t k) const noexcept override { return {0.002 * double(k), 0.2}; }
+template <typename T>
+struct Constant final : ReferenceSource<T> {
+  Reference<T> at_tick(uint64_t k) const noexcept override {
+    return {T(0.002 * double(k)), T(0.2)};
+  }
 };
 
 /// Runs the drive's tick with allocation counting on.
@@ -60,7 +63,7 @@ void run_without_allocation() {
   config.i_max_A = 6.0;
   config.protection.overcurrent_A = 9.0;
   config.speed_reaching_pole = config.flux_reaching_pole = 0.98;
-  const Constant references;
+  const Constant<T> references;
   Drive<T> drive(test::test_motors()[0].parameters, config,
                  {board.pwm(), board.encoder(), board.adc(), board.timer()}, references);
   CountingHandler<T> handler(drive);
@@ -85,7 +88,7 @@ TEST(DriveTick, OvercurrentTurnsThePwmOffInTheSameTick) {
   config.protection.tick_budget_ns = 0;  // wall-clock time on a shared host is not the MCU's
   config.i_max_A = 6.0;
   config.protection.overcurrent_A = 9.0;
-  const Constant references;
+  const Constant<double> references;
   Drive<double> drive(test::test_motors()[0].parameters, config,
                       {board.pwm(), board.encoder(), board.adc(), board.timer()}, references);
   board.timer().start(drive);
@@ -106,7 +109,7 @@ TEST(DriveTick, OvercurrentTurnsThePwmOffInTheSameTick) {
 /// A drive on the board, wired, with the given configuration.
 struct Rig {
   sim::SimBoard board;
-  Constant references;
+  Constant<double> references;
   Drive<double> drive;
   Rig(const sim::SimBoardConfig& board_config, const DriveConfig& config)
       : board(test::test_motors()[0].parameters, board_config),

@@ -125,3 +125,31 @@ TEST(EncoderObserver, TracksSpeedAndLoadFromAQuantizedAngle) {
 
 }  // namespace
 }  // namespace imd::control
+
+namespace imd::control {
+namespace {
+
+// wrap_pi's fast path (one exact subtraction within two turns) must give fmod's result bit
+// for bit, in both precisions, or the double runs would lose their reproducibility.
+template <typename T>
+T wrap_pi_by_fmod(T angle_rad) {
+  const T two_pi = T(2 * std::numbers::pi);
+  angle_rad = std::fmod(angle_rad + T(std::numbers::pi), two_pi);
+  return (angle_rad < T(0) ? angle_rad + two_pi : angle_rad) - T(std::numbers::pi);
+}
+
+template <typename T>
+void expect_wrap_pi_is_fmods() {
+  for (int i = -200'000; i <= 200'000; ++i) {
+    const T angle = T(i) * T(3.1e-4);  // -62 .. 62 rad: both paths
+    ASSERT_EQ(wrap_pi(angle), wrap_pi_by_fmod(angle)) << angle;
+  }
+}
+
+TEST(WrapPi, EqualsTheFmodFormulaBitForBit) {
+  expect_wrap_pi_is_fmods<float>();
+  expect_wrap_pi_is_fmods<double>();
+}
+
+}  // namespace
+}  // namespace imd::control

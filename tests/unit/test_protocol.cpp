@@ -54,6 +54,16 @@ TEST(SignalPacking, RoundTripsSignedValuesAndSaturates) {
   EXPECT_EQ(get_raw(data, kSpeedFluxSignals[1]), 700);
 }
 
+// The MCU converts raw values with single-precision instructions only: every whole-valued
+// float must come out exactly as the plain cast gives it, on both sides of 2^31 and 2^32.
+TEST(SignalPacking, FloatToInt64IsExactWithoutDouble) {
+  for (const float whole : {0.0f, 1.0f, -1.0f, 16777216.0f, -2147483648.0f, 2147483520.0f,
+                            2147483648.0f, 4294967040.0f, 4294967296.0f, -4294967296.0f,
+                            1099511627776.0f, -1099511627776.0f, 4.6116860e18f, -9.2233720e18f}) {
+    EXPECT_EQ(protocol::float_to_int64(whole), static_cast<int64_t>(whole)) << whole;
+  }
+}
+
 TEST(SignalPacking, NodeAndMessageFormTheIdentifier) {
   EXPECT_EQ(can_id(1, MessageId::heartbeat), 0x22);
   EXPECT_EQ(can_id(63, MessageId::timing), 63 * 32 + 0x13);

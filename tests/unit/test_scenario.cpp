@@ -304,6 +304,8 @@ TEST(Scenario, BadEventsNameTheEntryKeyAndValue) {
       {fault + "kind = \"undervoltage\"\nbus_V = 350",
        "faults[0].bus_V: = 350: must be below inverter.v_bus_V (311 V) for undervoltage"},
       {fault + "kind = \"overrun\"\nstall_us = 0", "faults[0].stall_us: = 0: must be > 0"},
+      {fault + "kind = \"overrun\"\nstall_us = 1e9",
+       "faults[0].stall_us: = 1000000000: must be below 1e9 us"},
       {fault + "kind = \"overcurrent\"\nsurge_a = 5", "unknown key faults[0].surge_a"},
       {fault + "kind = \"adc_stuck\"\n[[faults]]\nat_s = 0.2\nkind = \"adc_stuk\"",
        "faults[1].kind: = \"adc_stuk\": must be one of"},
@@ -336,6 +338,39 @@ TEST(Scenario, BadEventsNameTheEntryKeyAndValue) {
     EXPECT_NE(message.find(c.message), std::string::npos)
         << "case " << i << "\nwant: " << c.message << "\ngot:  " << message;
   }
+}
+
+TEST(Scenario, StepProfilesHoldAtMostKMaxSteps) {
+  static_assert(LoadProfile::kMaxSteps == SpeedProfile::kMaxSteps);
+  constexpr std::size_t kMax = SpeedProfile::kMaxSteps;
+  const auto steps = [](const std::string& table, const std::string& values_key, std::size_t n) {
+    std::string list;
+    for (std::size_t i = 0; i < n; ++i) list += (i == 0 ? "" : ", ") + std::to_string(i);
+    return "[" + table + "]\nkind = \"steps\"\ntimes_s = [" + list + "]\n" + values_key + " = [" +
+           list + "]\n";
+  };
+  // At capacity: every step is kept.
+  const Scenario full = load_scenario(write_scenario(
+      "steps_full",
+      steps("reference.speed", "values_rad_s", kMax) + steps("load", "values_Nm", kMax), false));
+  EXPECT_EQ(full.speed.step_count, kMax);
+  EXPECT_EQ(full.speed.at(-0.5), 0.0);
+  EXPECT_EQ(full.speed.at(5.5), 5.0);
+  EXPECT_EQ(full.speed.at(1e3), double(kMax - 1));
+  EXPECT_EQ(full.load.step_count, kMax);
+  EXPECT_EQ(full.load.at(1e3), double(kMax - 1));
+  // One more: the loader names the key.
+  const std::string speed_error = error_of(
+      write_scenario("steps_speed_over", steps("reference.speed", "values_rad_s", kMax + 1), false),
+      {});
+  EXPECT_NE(speed_error.find("reference.speed.times_s: has 33 entries: must have at most 32"),
+            std::string::npos)
+      << speed_error;
+  const std::string load_error =
+      error_of(write_scenario("steps_load_over", steps("load", "values_Nm", kMax + 1)), {});
+  EXPECT_NE(load_error.find("load.times_s: has 33 entries: must have at most 32"),
+            std::string::npos)
+      << load_error;
 }
 
 }  // namespace

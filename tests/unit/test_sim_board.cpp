@@ -5,14 +5,15 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
-#include <stdexcept>
 #include <vector>
 
 #include "control/svpwm.hpp"
 #include "hal_sim/fault_injection.hpp"
 #include "hal_sim/sensor_models.hpp"
 #include "hal_sim/sim_board.hpp"
+#include "hal_sim/sim_can_host.hpp"
 #include "test_motors.hpp"
 
 namespace imd::sim {
@@ -186,7 +187,7 @@ TEST(SimBoardFaults, OvercurrentSurgeAppearsInTheNextAdcSample) {
     s.i_s_alphabeta_A = {1.0, -0.5};
     board.plant().set_state(s);
     const auto before_A = phase_currents_A(board);
-    board.inject({.kind = FaultKind::overcurrent, .surge_A = surge_A, .phase = phase});
+    ASSERT_TRUE(board.inject({.kind = FaultKind::overcurrent, .surge_A = surge_A, .phase = phase}));
     board.run_tick();
     ASSERT_EQ(probe.samples.size(), 1u);
     // Along phase k's axis the surge adds surge_A to phase k and -surge_A/2 to the two others
@@ -214,7 +215,7 @@ TEST(SimBoardFaults, BusFaultsChangeTheMeasuredAndAppliedBus) {
     probe.duty = {0.7f, 0.4f, 0.4f};
     board.run_tick();
     EXPECT_EQ(probe.samples[0].bus_code, std::lround(311.0 / volts_per_code));
-    board.inject({.kind = kind, .bus_V = bus_V});
+    ASSERT_TRUE(board.inject({.kind = kind, .bus_V = bus_V}));
     EXPECT_EQ(board.v_bus_V(), bus_V);
     board.run_tick();
     // Same arithmetic as the converter and the inverter model: exact.
@@ -233,7 +234,7 @@ TEST(SimBoardFaults, EncoderLossFreezesTheCount) {
   board.run_tick();
   board.run_tick();
   ASSERT_NE(probe.counts[1], probe.counts[0]);
-  board.inject({.kind = FaultKind::encoder_loss});
+  ASSERT_TRUE(board.inject({.kind = FaultKind::encoder_loss}));
   for (int k = 0; k < 100; ++k) board.run_tick();
   for (std::size_t k = 2; k < probe.counts.size(); ++k) ASSERT_EQ(probe.counts[k], probe.counts[1]);
   // Meanwhile the rotor turned 1 rad, 1304 counts.
@@ -252,7 +253,7 @@ TEST(SimBoardFaults, StuckAdcRepeatsItsLastConversion) {
   };
   for (int k = 0; k < 10; ++k) board.run_tick();
   for (int k = 1; k < 10; ++k) ASSERT_FALSE(same(probe.samples[k], probe.samples[k - 1]));
-  board.inject({.kind = FaultKind::adc_stuck});
+  ASSERT_TRUE(board.inject({.kind = FaultKind::adc_stuck}));
   for (int k = 0; k < 50; ++k) board.run_tick();
   for (std::size_t k = 10; k < probe.samples.size(); ++k) {
     ASSERT_TRUE(same(probe.samples[k], probe.samples[9])) << "tick " << k;
@@ -267,7 +268,7 @@ TEST(SimBoardFaults, PhaseLossHoldsThatPhaseCurrentAtZero) {
     probe.frequency_Hz = 25.0;
     for (int k = 0; k < 500; ++k) board.run_tick();
     ASSERT_GT(board.plant().state().i_s_alphabeta_A.norm(), 0.5);
-    board.inject({.kind = FaultKind::phase_loss, .phase = open});
+    ASSERT_TRUE(board.inject({.kind = FaultKind::phase_loss, .phase = open}));
     const std::size_t first = probe.samples.size();
     double open_max_A = std::abs(phase_currents_A(board)[open]), other_max_A = 0.0;
     for (int k = 0; k < 2000; ++k) {  // 0.2 s, five periods of the supply
@@ -335,10 +336,10 @@ TEST(SimBoardFaults, TwoOpenPhasesLeaveNoCurrentPath) {
   probe.amplitude_V = 100.0;
   probe.frequency_Hz = 25.0;
   for (int k = 0; k < 500; ++k) board.run_tick();
-  board.inject({.kind = FaultKind::phase_loss, .phase = 0});
+  ASSERT_TRUE(board.inject({.kind = FaultKind::phase_loss, .phase = 0}));
   for (int k = 0; k < 100; ++k) board.run_tick();
   ASSERT_GT(board.plant().state().i_s_alphabeta_A.norm(), 0.5);  // b and c still carry current
-  board.inject({.kind = FaultKind::phase_loss, .phase = 2});
+  ASSERT_TRUE(board.inject({.kind = FaultKind::phase_loss, .phase = 2}));
   EXPECT_EQ(board.plant().open_phases(), 0b101u);
   for (int k = 0; k < 500; ++k) {
     board.run_tick();
@@ -354,7 +355,7 @@ TEST(SimBoardFaults, OverrunStallsTheExecutionClockInsideEachTick) {
   // that long would be needed to break the bounds below).
   const uint64_t stall_ns = 500'000'000;
   board.run_tick();
-  board.inject({.kind = FaultKind::overrun, .stall_us = 5e5});
+  ASSERT_TRUE(board.inject({.kind = FaultKind::overrun, .stall_us = 5e5}));
   board.run_tick();
   board.run_tick();
   const uint64_t after_ns = board.timer().execution_clock_ns();
@@ -379,7 +380,7 @@ TEST(SimBoardFaults, CanSilenceDropsFramesForTheFirmwareOnly) {
   frame.id = 0x27;
   frame.length = 2;
   ASSERT_TRUE(board.can_side().inject(frame));
-  board.inject({.kind = FaultKind::can_silence});
+  ASSERT_TRUE(board.inject({.kind = FaultKind::can_silence}));
   frame.id = 0x28;
   for (int k = 0; k < 3; ++k) EXPECT_FALSE(board.can_side().inject(frame));
   EXPECT_EQ(board.can_side().dropped_frames(), 3u);
@@ -388,26 +389,71 @@ TEST(SimBoardFaults, CanSilenceDropsFramesForTheFirmwareOnly) {
   EXPECT_EQ(received.id, 0x27);
   EXPECT_FALSE(board.can().try_receive(received));
   EXPECT_TRUE(board.can().try_send(frame));  // the firmware still talks
-  const auto sent = board.can_side().take_sent();
-  ASSERT_EQ(sent.size(), 1u);
-  EXPECT_EQ(sent[0].id, 0x28);
+  hal::CanFrame sent;
+  ASSERT_TRUE(board.can_side().take_sent(sent));
+  EXPECT_EQ(sent.id, 0x28);
+  EXPECT_FALSE(board.can_side().take_sent(sent));
 }
 
-TEST(SimBoardFaults, InjectRejectsParametersOutOfRangeAndLogsTheRest) {
+TEST(SimBoardCan, QueuesHoldKQueueDepthFramesEachWayInOrder) {
+  SimCan can;
+  hal::CanFrame frame;
+  for (uint16_t id = 0; id < SimCan::kQueueDepth; ++id) {
+    frame.id = id;
+    ASSERT_TRUE(can.try_send(frame)) << id;
+    ASSERT_TRUE(can.inject(frame)) << id;
+  }
+  EXPECT_FALSE(can.try_send(frame));    // full: the firmware's frame is not queued
+  EXPECT_FALSE(can.inject(frame));      // full: the host's frame is lost
+  EXPECT_EQ(can.dropped_frames(), 0u);  // counts the silence only
+  const std::vector<hal::CanFrame> sent = take_all_sent(can);
+  ASSERT_EQ(sent.size(), SimCan::kQueueDepth);
+  for (uint16_t id = 0; id < SimCan::kQueueDepth; ++id) {
+    EXPECT_EQ(sent[id].id, id);
+    ASSERT_TRUE(can.try_receive(frame));
+    EXPECT_EQ(frame.id, id);
+  }
+  EXPECT_FALSE(can.try_receive(frame));
+  EXPECT_TRUE(can.try_send(frame));  // room again
+}
+
+TEST(SimBoardFaults, InjectRefusesParametersOutOfRangeAndChangesNothing) {
   SimBoard board(seed000(), {});
-  EXPECT_THROW(board.inject({.kind = FaultKind::overcurrent}), std::invalid_argument);  // NaN
-  EXPECT_THROW(board.inject({.kind = FaultKind::overcurrent, .surge_A = 2.0, .phase = 3}),
-               std::invalid_argument);
-  EXPECT_THROW(board.inject({.kind = FaultKind::phase_loss, .phase = -1}), std::invalid_argument);
-  EXPECT_THROW(board.inject({.kind = FaultKind::undervoltage, .bus_V = -1.0}),
-               std::invalid_argument);
-  EXPECT_THROW(board.inject({.kind = FaultKind::overrun, .stall_us = 0.0}), std::invalid_argument);
-  EXPECT_TRUE(board.injected().empty());
-  board.inject({.at_s = 0.1, .kind = FaultKind::encoder_loss});
-  board.inject({.at_s = 0.2, .kind = FaultKind::adc_stuck});
-  ASSERT_EQ(board.injected().size(), 2u);
-  EXPECT_EQ(board.injected()[0].kind, FaultKind::encoder_loss);
-  EXPECT_EQ(board.injected()[1].at_s, 0.2);
+  struct Case {
+    FaultInjection fault;
+    const char* message;
+  };
+  const Case cases[] = {
+      {{.kind = FaultKind::overcurrent}, "overcurrent: surge_A must be > 0 and finite"},  // NaN
+      {{.kind = FaultKind::overcurrent, .surge_A = std::numeric_limits<double>::infinity()},
+       "overcurrent: surge_A must be > 0 and finite"},
+      {{.kind = FaultKind::overcurrent, .surge_A = 2.0, .phase = 3},
+       "overcurrent: phase must be 0, 1 or 2"},
+      {{.kind = FaultKind::phase_loss, .phase = -1}, "phase_loss: phase must be 0, 1 or 2"},
+      {{.kind = FaultKind::undervoltage, .bus_V = -1.0},
+       "undervoltage: bus_V must be > 0 and finite"},
+      {{.kind = FaultKind::overvoltage}, "overvoltage: bus_V must be > 0 and finite"},
+      {{.kind = FaultKind::overrun, .stall_us = 0.0},
+       "overrun: stall_us must be > 0 and below 1e9"},
+      {{.kind = FaultKind::overrun, .stall_us = 1e9},
+       "overrun: stall_us must be > 0 and below 1e9"},
+  };
+  const PlantState before = board.plant().state();
+  for (const Case& c : cases) {
+    EXPECT_FALSE(board.inject(c.fault)) << c.message;
+    const char* message = fault_parameter_error(c.fault);
+    ASSERT_NE(message, nullptr) << c.message;
+    EXPECT_STREQ(message, c.message);
+  }
+  EXPECT_EQ(board.injected_count(), 0u);
+  EXPECT_EQ(board.plant().state().i_s_alphabeta_A, before.i_s_alphabeta_A);
+  EXPECT_EQ(board.plant().open_phases(), 0u);
+  EXPECT_EQ(board.v_bus_V(), board.config().v_bus_V);
+
+  EXPECT_EQ(fault_parameter_error({.kind = FaultKind::encoder_loss}), nullptr);
+  ASSERT_TRUE(board.inject({.at_s = 0.1, .kind = FaultKind::encoder_loss}));
+  ASSERT_TRUE(board.inject({.at_s = 0.2, .kind = FaultKind::adc_stuck}));
+  EXPECT_EQ(board.injected_count(), 2u);
   EXPECT_TRUE(board.encoder_frozen());
   EXPECT_TRUE(board.adc_stuck());
 }

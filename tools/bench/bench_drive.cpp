@@ -45,8 +45,10 @@ void BM_TickOnly(benchmark::State& bench) {
   board_config.adc.full_scale_A = 10.0;
   board_config.adc.noise_A = 0.01;
   imd::sim::SimBoard board(s.motor, board_config);
-  struct Constant final : imd::firmware::ReferenceSource {
-    imd::firmware::Reference at_tick(uint64_t) const noexcept override { return {50.0, 0.2}; }
+  struct Constant final : imd::firmware::ReferenceSource<T> {
+    imd::firmware::Reference<T> at_tick(uint64_t) const noexcept override {
+      return {T(50), T(0.2)};
+    }
   } references;
   imd::firmware::DriveConfig config;
   config.i_max_A = 6.0;

@@ -3,29 +3,34 @@
 #include <bit>
 #include <chrono>
 #include <cmath>
+#include <stdexcept>
 
 #include "control/exact_model_001.hpp"
 #include "control/frames.hpp"
 #include "firmware/drive.hpp"
+#include "firmware/sim/run_metrics.hpp"
 #include "firmware/sim/scenario_config.hpp"
 #include "hal_sim/sim_board.hpp"
+#include "hal_sim/sim_can_host.hpp"
 #include "tools/drive_sim/scripted_commands.hpp"
 
 namespace imd::sim {
 namespace {
 
 /// The plant's state in the rotor frame: the "ideal sensors" of paper 000, Section III.
-class PlantOracle final : public firmware::StateOracle {
+/// T: the drive's arithmetic; the plant's double state is rounded to it.
+template <typename T>
+class PlantOracle final : public firmware::StateOracle<T> {
  public:
   explicit PlantOracle(const SimBoard& board) : board_(board) {}
-  firmware::TrueState true_state() const noexcept override {
+  firmware::TrueState<T> true_state() const noexcept override {
     const PlantState& s = board_.plant().state();
     const auto rotor =
         control::Rotation<double>::from_angle(board_.plant().pole_pairs() * s.theta_mech_rad);
     const Vec2 flux = rotor.apply_inverse(s.flux_r_alphabeta_Wb);
     const Vec2 current = rotor.apply_inverse(s.i_s_alphabeta_A);
-    return {flux.x(),           flux.y(),         current.x(),     current.y(),
-            s.omega_mech_rad_s, s.theta_mech_rad, board_.load_Nm()};
+    return {T(flux.x()),           T(flux.y()),         T(current.x()),       T(current.y()),
+            T(s.omega_mech_rad_s), T(s.theta_mech_rad), T(board_.load_Nm())};
   }
 
  private:
@@ -36,8 +41,8 @@ template <typename T>
 Summary run(const Scenario& s, const RunCallbacks& callbacks) {
   SimBoard board(s.motor, firmware::board_config(s));
   firmware::prepare_board(board, s);
-  const firmware::ScenarioReferences references(s);
-  const PlantOracle oracle(board);
+  const firmware::ScenarioReferences<T> references(s);
+  const PlantOracle<T> oracle(board);
   firmware::Drive<T> drive(s.motor, firmware::drive_config(s),
                            {board.pwm(), board.encoder(), board.adc(), board.timer(),
                             &board.analog_inner_loop(), &board.current_source(), &board.can()},
@@ -53,7 +58,8 @@ Summary run(const Scenario& s, const RunCallbacks& callbacks) {
   auto last_progress = wall_start;
   const auto ticks = static_cast<uint64_t>(std::llround(s.duration_s / s.sample_period_s));
   const control::MotorParameters& m = s.motor;
-  double speed_sq = 0, flux_sq = 0, load_sq = 0, torque_sq = 0;
+  firmware::RunMetrics metrics(s.settle_s);
+  double torque_sq = 0;
   uint64_t torque_count = 0;
   double hold_sq = 0;
   uint64_t hold_count = 0;
@@ -64,7 +70,6 @@ Summary run(const Scenario& s, const RunCallbacks& callbacks) {
   struct {
     double torque_ref_Nm = 0.0, y2 = 0.0, y2_ref = 0.0;
   } held;  // iol values of the last boundary, held until the next
-  uint64_t measured = 0, saturated = 0;
   std::vector<hal::CanFrame> sent_frames;  // reused: no allocation per tick
   uint16_t last_fault_bits = 0;
   bool diverged = false;
@@ -76,7 +81,10 @@ Summary run(const Scenario& s, const RunCallbacks& callbacks) {
           commands[next_command].frame);  // a full queue loses it, as a bus would
     }
     for (; next_fault < s.faults.size() && s.faults[next_fault].at_s <= t_s + 1e-12; ++next_fault) {
-      board.inject(s.faults[next_fault]);
+      // load_scenario refuses such faults; a scenario built in code may still hold one.
+      if (!board.inject(s.faults[next_fault])) {
+        throw std::invalid_argument(s.source + ": " + fault_parameter_error(s.faults[next_fault]));
+      }
       unanswered.push_back(summary.faults.size());
       summary.faults.push_back(
           {"none", fault_kind_name(s.faults[next_fault].kind), t_s, std::nan(""), std::nan("")});
@@ -91,8 +99,8 @@ Summary run(const Scenario& s, const RunCallbacks& callbacks) {
     }
     const double load_Nm = board.load_Nm();
     board.run_tick();
-    const firmware::TickRecord& rec = drive.record();
-    board.can_side().take_sent(sent_frames);
+    const firmware::TickRecord<T>& rec = drive.record();
+    take_all_sent(board.can_side(), sent_frames);
     if (callbacks.can_frame) {
       for (const hal::CanFrame& frame : sent_frames) callbacks.can_frame(t_s, frame);
     }
@@ -166,7 +174,6 @@ Summary run(const Scenario& s, const RunCallbacks& callbacks) {
     row.saturated = rec.speed_saturated || rec.flux_saturated || rec.voltage_clipped;
 
     const double current_A = truth.i_s_alphabeta_A.norm();
-    summary.i_peak_total_A = std::max(summary.i_peak_total_A, current_A);
     if (summary.running_from_s < 0 && rec.state == firmware::DriveState::running)
       summary.running_from_s = t_s;
     // Faults the drive latched this tick, the first one first; each answers the oldest
@@ -192,20 +199,11 @@ Summary run(const Scenario& s, const RunCallbacks& callbacks) {
       awaiting_pwm_off.clear();
     }
     // Over CAN the drive is stopped and started at the host's will: only running ticks count.
-    const bool measuring = s.command_source != "can" || rec.state == firmware::DriveState::running;
-    if (t_s > s.settle_s && measuring) {
-      const double speed_err = row.omega_mech_rad_s - row.omega_ref_rad_s;
-      const double flux_err =
-          iol ? row.stator_flux2_Wb2 - row.stator_flux2_ref_Wb2 : row.flux2_Wb2 - row.flux2_ref_Wb2;
-      speed_sq += speed_err * speed_err;
-      flux_sq += flux_err * flux_err;
-      load_sq += (row.load_est_Nm - row.load_Nm) * (row.load_est_Nm - row.load_Nm);
-      summary.speed_max_err_rad_s = std::max(summary.speed_max_err_rad_s, std::abs(speed_err));
-      summary.flux2_max_err_Wb2 = std::max(summary.flux2_max_err_Wb2, std::abs(flux_err));
-      summary.i_peak_A = std::max(summary.i_peak_A, current_A);
-      saturated += row.saturated ? 1 : 0;
-      ++measured;
-    }
+    metrics.add({t_s, s.command_source != "can" || rec.state == firmware::DriveState::running,
+                 row.omega_mech_rad_s - row.omega_ref_rad_s,
+                 iol ? row.stator_flux2_Wb2 - row.stator_flux2_ref_Wb2
+                     : row.flux2_Wb2 - row.flux2_ref_Wb2,
+                 row.load_est_Nm - row.load_Nm, current_A, row.saturated});
     if (callbacks.row) callbacks.row(row);
     if (callbacks.progress && (k & 1023) == 0) {
       const auto now = std::chrono::steady_clock::now();
@@ -220,14 +218,14 @@ Summary run(const Scenario& s, const RunCallbacks& callbacks) {
   summary.wall_time_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
   // Nothing after settle_s (a run that ended early): the metrics are not defined (null in JSON).
-  const double n = measured > 0 ? double(measured) : std::nan("");
-  summary.speed_rms_err_rad_s = std::sqrt(speed_sq / n);
-  summary.flux2_rms_err_Wb2 = std::sqrt(flux_sq / n);
-  summary.load_est_rms_err_Nm = std::sqrt(load_sq / n);
-  summary.saturated_fraction = double(saturated) / n;
-  if (measured == 0) {
-    summary.speed_max_err_rad_s = summary.flux2_max_err_Wb2 = summary.i_peak_A = std::nan("");
-  }
+  summary.speed_rms_err_rad_s = metrics.speed_rms_err_rad_s();
+  summary.speed_max_err_rad_s = metrics.speed_max_err_rad_s();
+  summary.flux2_rms_err_Wb2 = metrics.flux2_rms_err_Wb2();
+  summary.flux2_max_err_Wb2 = metrics.flux2_max_err_Wb2();
+  summary.load_est_rms_err_Nm = metrics.load_est_rms_err_Nm();
+  summary.i_peak_A = metrics.i_peak_A();
+  summary.i_peak_total_A = metrics.i_peak_total_A();
+  summary.saturated_fraction = metrics.saturated_fraction();
   if (iol && !s.outer_speed_loop) {  // a torque-controlled run has no speed reference
     summary.speed_rms_err_rad_s = summary.speed_max_err_rad_s = std::nan("");
   }

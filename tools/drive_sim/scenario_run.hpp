@@ -79,6 +79,8 @@ struct RunCallbacks {
   Frame can_frame;    ///< every frame the firmware sent, with the time of the tick that sent it
 };
 
+/// Throws std::invalid_argument on a fault SimBoard refuses (fault_parameter_error), which
+/// load_scenario never lets through.
 Summary run_scenario(const Scenario& scenario, const RunCallbacks& callbacks = {});
 
 }  // namespace imd::sim

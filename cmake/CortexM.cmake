@@ -1,0 +1,50 @@
+# Firmware images for Cortex-M4F targets.
+#
+# imd_add_cortex_m_image(NAME LINKER_SCRIPT script [TICK_ROOTS sym...] SOURCES src... LIBRARIES lib...)
+# links NAME.elf with the target's linker script and writes NAME.map and NAME.size.txt. The
+# link itself refuses exceptions: every throw entry point is wrapped (--wrap) and the wrappers
+# are never defined, so a reference fails with "undefined reference to `__wrap___cxa_throw'".
+# operator new is never defined either. The C allocator is wrapped to traps (there is no heap,
+# hal/cortex_m/no_heap.cpp says why it is named at all). With TICK_ROOTS,
+# tools/check_tick_path.py then follows the static call graph from those interrupt entries and
+# fails the build if the tick can reach double-precision soft-float, the allocator (or its
+# traps) or exceptions.
+find_package(Python3 REQUIRED COMPONENTS Interpreter)
+
+set(IMD_NO_HEAP_NO_EXCEPTIONS_WRAPS
+    malloc free calloc realloc memalign _malloc_r _free_r _calloc_r _realloc_r _memalign_r
+    __cxa_allocate_exception __cxa_throw __cxa_rethrow __cxa_begin_catch _Unwind_Resume
+    _Unwind_RaiseException)
+
+find_program(IMD_ARM_SIZE arm-none-eabi-size REQUIRED)
+
+function(imd_add_cortex_m_image NAME)
+  cmake_parse_arguments(ARG "" "LINKER_SCRIPT" "TICK_ROOTS;SOURCES;LIBRARIES" ${ARGN})
+  add_executable(${NAME} ${ARG_SOURCES})
+  set_target_properties(${NAME} PROPERTIES SUFFIX ".elf")
+  target_link_libraries(${NAME} PRIVATE ${ARG_LIBRARIES} imd_hal_cortex_m imd_cortex_m_runtime)
+  get_filename_component(script_dir ${ARG_LINKER_SCRIPT} DIRECTORY)
+  set(wraps "")
+  foreach(symbol IN LISTS IMD_NO_HEAP_NO_EXCEPTIONS_WRAPS)
+    list(APPEND wraps "LINKER:--wrap=${symbol}")
+  endforeach()
+  target_link_options(${NAME} PRIVATE -nostartfiles -T ${ARG_LINKER_SCRIPT} -L ${script_dir}
+                      "LINKER:-Map=$<TARGET_FILE_DIR:${NAME}>/${NAME}.map"
+                      ${wraps})
+  set_property(TARGET ${NAME} APPEND PROPERTY LINK_DEPENDS ${ARG_LINKER_SCRIPT})
+  add_custom_command(TARGET ${NAME} POST_BUILD
+    COMMAND ${IMD_ARM_SIZE} $<TARGET_FILE:${NAME}> > $<TARGET_FILE_DIR:${NAME}>/${NAME}.size.txt
+    VERBATIM)
+  if(ARG_TICK_ROOTS)
+    set(roots "")
+    foreach(root IN LISTS ARG_TICK_ROOTS)
+      list(APPEND roots --root ${root})
+    endforeach()
+    add_custom_command(TARGET ${NAME} POST_BUILD
+      COMMAND ${Python3_EXECUTABLE} ${PROJECT_SOURCE_DIR}/tools/check_tick_path.py
+              --objdump ${CMAKE_OBJDUMP} $<TARGET_FILE:${NAME}> ${roots}
+              --deny-regex "^__wrap_"
+              --report $<TARGET_FILE_DIR:${NAME}>/${NAME}.tick_path.txt
+      VERBATIM)
+  endif()
+endfunction()

@@ -1,0 +1,125 @@
+/// Processor in the loop: the drive firmware on an emulated Cortex-M4F (QEMU mps2-an386)
+/// against the simulated board, compiled for the MCU too. The 10 kHz tick runs from SysTick in
+/// its two stages (hal/cortex_m/two_stage_tick.hpp): the sample stage latches the simulated
+/// sensors, the control stage runs Drive<float>. The timer is in lock-step: after each tick
+/// time stands still while the main loop advances the plant by one period (in double, which
+/// this FPU does not have, so it is far slower than real time) and fills the references ahead.
+/// The scenario is compiled in (seed000_realistic_scenario.cpp). At the end the summary goes
+/// to the UART and the run ends through semihosting with the exit status:
+///   0 the run completed with no fault and no overrun, 1 it did not, 3 a processor fault.
+#include <cstdint>
+
+#include "firmware/cortex_m/pil/mps2_an386.hpp"
+#include "firmware/cortex_m/pil/pil_report.hpp"
+#include "firmware/drive.hpp"
+#include "firmware/sim/embedded_scenario.hpp"
+#include "firmware/sim/lookahead_references.hpp"
+#include "firmware/sim/run_metrics.hpp"
+#include "hal/cortex_m/armv7m.hpp"
+#include "hal/cortex_m/cmsdk_uart.hpp"
+#include "hal/cortex_m/fault_handler.hpp"
+#include "hal/cortex_m/semihosting.hpp"
+#include "hal/cortex_m/two_stage_tick.hpp"
+#include "hal_sim/sim_board.hpp"
+
+namespace imd::firmware {
+
+extern const EmbeddedScenario kSeed000Realistic;
+
+namespace {
+
+namespace cm = hal::cortex_m;
+
+/// The sample stage: the simulated ADC and encoder latch the plant's state at t_k.
+class SimulatedSensors final : public cm::SampleStage {
+ public:
+  explicit SimulatedSensors(sim::SimBoard& board) : board_(board) {}
+  void sample() noexcept override { board_.begin_period(); }
+
+ private:
+  sim::SimBoard& board_;
+};
+
+cm::CmsdkUart* g_console = nullptr;
+
+/// Sleeps until the control stage of this tick has finished. Interrupts are masked around the
+/// test so that the end of the tick cannot slip in between the test and the sleep (WFI still
+/// wakes on a pending interrupt).
+void wait_for_tick(const cm::TwoStageTick& timer) noexcept {
+  for (;;) {
+    cm::disable_interrupts();
+    if (timer.paused()) break;
+    cm::wait_for_interrupt();
+    cm::enable_interrupts();
+  }
+  cm::enable_interrupts();
+}
+
+int run(const EmbeddedScenario& s, cm::CmsdkUart& console) {
+  static sim::SimBoard board(s.motor, s.board);
+  board.set_load_profile(s.load);
+  board.plant().set_state(s.initial_state);
+  static LookaheadReferences<float> references(s.references, s.drive.sample_period_s);
+  static SimulatedSensors sensors(board);
+  static cm::TwoStageTick timer(
+      {mps2::kCoreClock_Hz, static_cast<uint32_t>(s.board.period_s * 1e9 + 0.5), true}, sensors);
+  static Drive<float> drive(s.motor, s.drive,
+                            {board.pwm(), board.encoder(), board.adc(), timer, nullptr, nullptr,
+                             &board.can(), nullptr},
+                            references);
+  RunMetrics metrics(s.settle_s);
+  PilReport report(console);
+  report.start(s, timer.counts_per_period());
+
+  const auto ticks = static_cast<uint64_t>(s.duration_s / s.board.period_s + 0.5);
+  uint64_t frames_sent = 0;
+  double running_from_s = -1.0;
+  hal::CanFrame frame;
+  references.fill_from(0);
+  cm::bind_tick_interrupts(timer);
+  timer.start(drive);
+  for (uint64_t k = 0; k < ticks; ++k) {
+    const double t_s = double(k) * s.board.period_s;
+    const sim::PlantState truth = board.plant().state();  // at t_k, before the tick
+    const double load_Nm = board.load_Nm();
+    if (k > 0) timer.resume();
+    wait_for_tick(timer);
+
+    // Time stands still: the tick's results, then the plant over [t_k, t_k+1].
+    const TickRecord<float>& rec = drive.record();
+    while (board.can_side().take_sent(frame)) ++frames_sent;  // the host side reads the bus
+    if (running_from_s < 0 && rec.state == DriveState::running) running_from_s = t_s;
+    metrics.add(tracking_sample(s, truth, load_Nm, rec, t_s));
+    board.end_period();
+    references.fill_from(k + 1);
+    if (!truth.i_s_alphabeta_A.allFinite()) break;
+  }
+  timer.stop();
+  return report.finish(drive, timer, metrics, running_from_s, frames_sent);
+}
+
+}  // namespace
+
+}  // namespace imd::firmware
+
+namespace imd::hal::cortex_m {
+
+void on_fatal_fault(FatalFault fault) noexcept {
+  // Nothing drives a power stage here; report and end the emulation.
+  if (imd::firmware::g_console != nullptr) {
+    imd::firmware::g_console->write("pil fatal_fault ");
+    imd::firmware::g_console->write(fatal_fault_name(fault));
+    imd::firmware::g_console->write("\n");
+  }
+  semihosting_exit(3);
+}
+
+}  // namespace imd::hal::cortex_m
+
+int main() {
+  using namespace imd;
+  static hal::cortex_m::CmsdkUart console(firmware::mps2::kUart0, firmware::mps2::kCoreClock_Hz,
+                                          firmware::mps2::kUartBaud_Hz);
+  firmware::g_console = &console;
+  hal::cortex_m::semihosting_exit(firmware::run(firmware::kSeed000Realistic, console));
+}

@@ -1,0 +1,31 @@
+// Roots for case_asm.S: SysTick_Handler -> asm_fall_a (falls into asm_fall_b -> malloc),
+// PendSV_Handler -> asm_veneer -> far_double, SVC_Handler -> asm_movw_call -> movw_target;
+// asm_irq_handler is in an interrupt vector.
+extern "C" {
+void asm_fall_a();
+void asm_veneer(float);
+void asm_movw_call(float);
+
+volatile double g_result;
+
+__attribute__((noinline)) void far_double(float x) {
+  g_result = x * 0.5;
+}
+__attribute__((noinline)) void movw_target(float x) {
+  g_result = x * 0.25;
+}
+void asm_irq_handler() {
+  g_result = g_result * 2.0;
+}
+
+void SysTick_Handler() {
+  asm_fall_a();
+}
+void PendSV_Handler() {
+  asm_veneer(1.0f);
+}
+void SVC_Handler() {
+  asm_movw_call(2.0f);
+}
+void fixture_init() {}
+}
