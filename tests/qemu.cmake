@@ -39,3 +39,29 @@ foreach(arch x86_64 aarch64)
   # limit covers the first run's kernel download as well as the guest's own 115 s limit.
   set_tests_properties(qemu_hil_${arch} PROPERTIES LABELS qemu RUN_SERIAL ON TIMEOUT 400)
 endforeach()
+
+# Processor in the loop: the Cortex-M4F image on QEMU's mps2-an386 (tests/qemu/pil_test.py),
+# built with the bare-metal toolchain in its own tree, like the cortex-m4f preset.
+find_program(IMD_ARM_NONE_EABI_CXX arm-none-eabi-g++)
+if(IMD_ARM_NONE_EABI_CXX)
+  ExternalProject_Add(qemu_programs_cortex_m4f
+    SOURCE_DIR ${PROJECT_SOURCE_DIR}
+    BINARY_DIR ${CMAKE_BINARY_DIR}/qemu-cortex-m4f
+    CMAKE_ARGS -DCMAKE_TOOLCHAIN_FILE=${PROJECT_SOURCE_DIR}/toolchains/arm-none-eabi-cortex-m4f.cmake
+               -DCMAKE_BUILD_TYPE=Release "-DCMAKE_CXX_FLAGS_RELEASE=-O2 -DNDEBUG"
+               -DIMD_BUILD_TESTS=OFF -DIMD_BUILD_BENCHMARKS=OFF
+    BUILD_COMMAND ${CMAKE_COMMAND} --build <BINARY_DIR> --target drive_pil_mps2_an386
+    INSTALL_COMMAND ""
+    BUILD_ALWAYS ON)
+else()
+  message(WARNING "arm-none-eabi-g++ not found: the qemu_pil_mps2_an386 test will fail "
+                  "(tools/install_deps.sh --cortex-m installs it)")
+endif()
+add_test(NAME qemu_pil_mps2_an386
+         COMMAND /usr/bin/python3 ${CMAKE_CURRENT_SOURCE_DIR}/qemu/pil_test.py
+                 --elf ${CMAKE_BINARY_DIR}/qemu-cortex-m4f/bin/drive_pil_mps2_an386.elf
+                 --drive-sim $<TARGET_FILE:drive_sim>
+                 --scenario ${PROJECT_SOURCE_DIR}/hal_sim/scenarios/seed000_realistic.toml
+                 --work ${CMAKE_BINARY_DIR}/qemu-work-pil)
+# Alone: the figures it prints are instruction counts, but one QEMU keeps a core busy.
+set_tests_properties(qemu_pil_mps2_an386 PROPERTIES LABELS qemu RUN_SERIAL ON TIMEOUT 900)

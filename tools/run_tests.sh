@@ -1,9 +1,10 @@
 #!/bin/sh
 # Test job: builds the host preset (Release with assertions) and runs every test tier, the
-# qemu tier included (QEMU, the aarch64 cross toolchain and Debian's kernels: see tests/qemu).
+# qemu tier included (QEMU, the aarch64 and Cortex-M4F cross toolchains and Debian's kernels:
+# see tests/qemu).
 set -eu
 cd "$(dirname "$0")/.."
-tools/install_deps.sh --qemu --aarch64
+tools/install_deps.sh --qemu --aarch64 --cortex-m
 cmake --preset host
 cmake --build --preset host
 ctest --preset host --parallel 2

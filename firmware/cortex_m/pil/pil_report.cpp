@@ -65,7 +65,7 @@ int PilReport::finish(const Drive<float>& drive, const hal::cortex_m::TwoStageTi
        << " stack_size_bytes " << uint64_t(hal::cortex_m::stack_size_bytes()) << "\n";
   console_.write(line.view());
   line.clear();
-  line << "pil fault " << fault_name(drive.fault()) << " state " << state_name(drive.state())
+  line << "pil fault code " << fault_name(drive.fault()) << " state " << state_name(drive.state())
        << "\n";
   console_.write(line.view());
 

@@ -1,0 +1,112 @@
+#!/usr/bin/python3
+"""The qemu tier's processor-in-the-loop test: runs the Cortex-M4F image (firmware/cortex_m/pil)
+on QEMU's mps2-an386 and compares its summary with the host build's float run of the same
+scenario (drive_sim, drive.precision=float).
+
+usage: pil_test.py --elf FILE --drive-sim FILE --scenario FILE --work DIR [--seeds N]
+
+The tolerance. The MCU and the host compute the same float control law with different rounding
+(the MCU fuses multiply-adds, its atan2f and sqrtf are newlib's), and the plant's ADC and
+encoder quantize: a last-bit difference flips one quantization decision, after which the two runs
+are two realizations of the same closed loop under the same noise statistics, not one
+trajectory. So the host is run again with N other ADC noise seeds, and each metric of the MCU
+must lie within 5 standard deviations of that seed-to-seed spread from the host's run of the
+scenario's own seed. For two independent draws the difference has sqrt(2) sd: 5 sd is 3.5 sd of
+the difference, about 5e-4 two-sided per metric. The start-up (calibration, magnetizing) has no
+spread; running_from_s must match within 2 ticks.
+
+Also checked: the run completed (exit status 0: no fault, no overrun), every tick ran, and the
+control path's instructions per tick (QEMU -icount shift=0: 1 ns of virtual time per
+instruction) are printed, with the 100 us budget at 170 MHz.
+"""
+import argparse
+import json
+import statistics
+import subprocess
+import sys
+from pathlib import Path
+
+METRICS = ["speed_rms_err_rad_s", "speed_max_err_rad_s", "flux2_rms_err_Wb2",
+           "flux2_max_err_Wb2", "load_est_rms_err_Nm", "i_peak_A", "i_peak_total_A",
+           "saturated_fraction"]
+SD_LIMIT = 5.0
+TICK_S = 1e-4
+QEMU_TIMEOUT_S = 600  # about 30 s on this machine's 2 cores
+
+
+def run_pil(elf):
+    cmd = ["qemu-system-arm", "-M", "mps2-an386", "-cpu", "cortex-m4", "-display", "none",
+           "-monitor", "none", "-serial", "stdio", "-semihosting-config",
+           "enable=on,target=native", "-icount", "shift=0,sleep=off", "-kernel", str(elf)]
+    print("pil_test: " + " ".join(cmd), flush=True)
+    done = subprocess.run(cmd, capture_output=True, text=True, timeout=QEMU_TIMEOUT_S)
+    sys.stdout.write(done.stdout)
+    sys.stderr.write(done.stderr)
+    fields = {}
+    for line in done.stdout.splitlines():
+        words = line.split()
+        if len(words) >= 3 and words[0] == "pil":
+            if words[1] == "metric":
+                fields[words[2]] = float(words[3])
+            else:  # "pil <kind> name value name value ..."
+                for name, value in zip(words[2::2], words[3::2]):
+                    fields[f"{words[1]}.{name}"] = value
+    return done.returncode, fields
+
+
+def run_host(drive_sim, scenario, work, seed):
+    out = work / f"host_float_seed{seed}.json"
+    subprocess.run([str(drive_sim), str(scenario), "--set", "drive.precision=float",
+                    "--set", f"simulation.seed={seed}", "--summary-json", str(out)],
+                   check=True, stdout=subprocess.DEVNULL)
+    return json.loads(out.read_text())
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--elf", required=True, type=Path)
+    parser.add_argument("--drive-sim", required=True, type=Path)
+    parser.add_argument("--scenario", required=True, type=Path)
+    parser.add_argument("--work", required=True, type=Path)
+    parser.add_argument("--seeds", type=int, default=16)
+    args = parser.parse_args()
+    args.work.mkdir(parents=True, exist_ok=True)
+
+    failed = 0
+
+    def check(ok, what, detail=""):
+        nonlocal failed
+        failed += 0 if ok else 1
+        print(f"pil_test: {'ok  ' if ok else 'FAIL'} {what}{': ' + detail if detail else ''}")
+
+    status, pil = run_pil(args.elf)
+    check(status == 0 and pil.get("end.status") == "0", "the MCU run completed",
+          f"exit {status}, fault {pil.get('fault.code')}, timer overruns "
+          f"{pil.get('tick.timer_overruns')}")
+    host = run_host(args.drive_sim, args.scenario, args.work, 1)
+    check(pil.get("tick.count") == str(host["ticks"]), "every tick ran",
+          f"{pil.get('tick.count')} of {host['ticks']}")
+    spread = [run_host(args.drive_sim, args.scenario, args.work, seed)
+              for seed in range(2, args.seeds + 2)]
+    print(f"pil_test: {'metric':22s} {'MCU':>12s} {'host float':>12s} {'seed sd':>10s} {'|d|/sd':>7s}")
+    for name in METRICS:
+        sd = statistics.stdev([run[name] for run in spread])
+        difference = abs(pil.get(name, float("nan")) - host[name])
+        ratio = difference / sd if sd > 0 else float("inf")
+        print(f"pil_test: {name:22s} {pil.get(name, float('nan')):12.6g} {host[name]:12.6g} "
+              f"{sd:10.3g} {ratio:7.2f}")
+        check(ratio <= SD_LIMIT, f"{name} within {SD_LIMIT:g} sd of the host's float run")
+    start_ticks = abs(pil.get("running_from_s", -1.0) - host["running_from_s"]) / TICK_S
+    check(start_ticks <= 2.0, "running from the same tick (within 2)",
+          f"MCU {pil.get('running_from_s')} s, host {host['running_from_s']} s")
+
+    mean, worst = int(pil.get("tick.exec_ns_mean", 0)), int(pil.get("tick.exec_ns_max", 0))
+    print(f"pil_test: control path per tick (Drive<float>::on_tick): mean {mean} instructions, "
+          f"max {worst}; at 170 MHz and 1 instruction per cycle {mean / 170:.1f} us mean, "
+          f"{worst / 170:.1f} us max: {mean / 170:.1f} % and {worst / 170:.1f} % of 100 us")
+    print(f"pil_test: {'passed' if failed == 0 else f'{failed} check(s) failed'}")
+    return 0 if failed == 0 else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())
