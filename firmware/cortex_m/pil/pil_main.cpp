@@ -69,7 +69,7 @@ int run(const EmbeddedScenario& s, cm::CmsdkUart& console) {
                             references);
   RunMetrics metrics(s.settle_s);
   PilReport report(console);
-  report.start(s, timer.counts_per_period());
+  report.start(s, timer.counts_per_period());  // with the stack used so far: the start-up's
 
   const auto ticks = static_cast<uint64_t>(s.duration_s / s.board.period_s + 0.5);
   uint64_t frames_sent = 0;

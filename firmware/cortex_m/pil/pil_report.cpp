@@ -25,7 +25,8 @@ void PilReport::start(const EmbeddedScenario& s, uint32_t counts_per_period) noe
   TextLine line;
   line << "pil start scenario " << s.name << " duration_s ";
   line.scientific(s.duration_s, 4) << " counts_per_period " << uint64_t(counts_per_period)
-                                   << "\n";
+                                   << " startup_stack_bytes "
+                                   << uint64_t(hal::cortex_m::stack_used_bytes()) << "\n";
   console_.write(line.view());
 }
 
