@@ -4,7 +4,7 @@
 /// clamped to the feasible inputs (the current then falls short of the target). It magnetizes
 /// the motor, and it is the inner current loop that imposes paper 001's current commands on a
 /// voltage inverter. Tick context.
-#include "control/exact_model_000.hpp"
+#include "control/voltage_fed_model.hpp"
 #include "control/frames.hpp"
 #include "control/input_disk.hpp"
 
@@ -13,7 +13,7 @@ namespace imd::control {
 template <typename T>
 class DeadbeatCurrent {
  public:
-  explicit DeadbeatCurrent(const ExactModel000Coefficients& c) noexcept
+  explicit DeadbeatCurrent(const VoltageFedCoefficients& c) noexcept
       : a21_(T(c.a21)), a22_(T(c.a22)), b2_(T(c.b2)) {}
 
   Vec2<T> input(const Vec2<T>& flux_r_AB_Wb, const Vec2<T>& i_s_AB_A, const Vec2<T>& i_target_AB_A,

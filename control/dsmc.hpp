@@ -19,7 +19,7 @@
 #include <cmath>
 #include <limits>
 
-#include "control/exact_model_000.hpp"
+#include "control/voltage_fed_model.hpp"
 #include "control/frames.hpp"
 #include "control/input_disk.hpp"
 
@@ -66,7 +66,7 @@ struct DsmcOutput {
 template <typename T>
 class Dsmc {
  public:
-  Dsmc(const ExactModel000Coefficients& c, const DsmcConfig& config) noexcept
+  Dsmc(const VoltageFedCoefficients& c, const DsmcConfig& config) noexcept
       : a11_(T(c.a11)),
         a12_(T(c.a12)),
         b1_(T(c.b1)),

@@ -15,7 +15,7 @@
 #include <cmath>
 #include <numbers>
 
-#include "control/exact_model_000.hpp"
+#include "control/voltage_fed_model.hpp"
 #include "control/frames.hpp"
 
 namespace imd::control {
@@ -25,7 +25,7 @@ struct EncoderObserverConfig {
 };
 
 /// Observer gain L for the mechanical model of `c` (Ackermann on the pair (A, C A)).
-inline Eigen::Vector3d place_encoder_observer(const ExactModel000Coefficients& c,
+inline Eigen::Vector3d place_encoder_observer(const VoltageFedCoefficients& c,
                                               double bandwidth_rad_s) {
   Eigen::Matrix3d a;
   a << 1.0, c.omega_to_theta_s, c.load_to_theta,  //
@@ -41,7 +41,7 @@ inline Eigen::Vector3d place_encoder_observer(const ExactModel000Coefficients& c
 }
 
 /// The error matrix A - L C A of the observer, for checks.
-inline Eigen::Matrix3d encoder_observer_error_matrix(const ExactModel000Coefficients& c,
+inline Eigen::Matrix3d encoder_observer_error_matrix(const VoltageFedCoefficients& c,
                                                      const Eigen::Vector3d& gain) {
   Eigen::Matrix3d a;
   a << 1.0, c.omega_to_theta_s, c.load_to_theta, 0.0, c.omega_decay, c.load_to_omega, 0.0, 0.0, 1.0;
@@ -67,7 +67,7 @@ T wrap_pi(T angle_rad) noexcept {
 template <typename T>
 class EncoderObserver {
  public:
-  EncoderObserver(const ExactModel000Coefficients& c, const EncoderObserverConfig& config)
+  EncoderObserver(const VoltageFedCoefficients& c, const EncoderObserverConfig& config)
       : omega_to_theta_(T(c.omega_to_theta_s)),
         load_to_theta_(T(c.load_to_theta)),
         omega_decay_minus_one_(T(c.omega_decay_minus_one)),

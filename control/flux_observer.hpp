@@ -3,7 +3,7 @@
 ///   Phi^_{k+1} = a11 Phi^_k + a12 I~_k + b1 v~_k,
 /// driven by the measured current and the input actually applied. Its error obeys
 /// e_{k+1} = a11 e_k with 0 < a11 < 1 (docs/derivations.md). Tick context.
-#include "control/exact_model_000.hpp"
+#include "control/voltage_fed_model.hpp"
 #include "control/frames.hpp"
 
 namespace imd::control {
@@ -11,7 +11,7 @@ namespace imd::control {
 template <typename T>
 class FluxObserver {
  public:
-  explicit FluxObserver(const ExactModel000Coefficients& c) noexcept
+  explicit FluxObserver(const VoltageFedCoefficients& c) noexcept
       : a11_(T(c.a11)), a12_(T(c.a12)), b1_(T(c.b1)) {}
 
   const Vec2<T>& flux_r_AB_Wb() const noexcept { return flux_; }

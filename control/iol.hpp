@@ -17,7 +17,7 @@
 /// inputs are refused: the current is held. Tick context; no division by zero.
 #include <cmath>
 
-#include "control/exact_model_001.hpp"
+#include "control/current_fed_model.hpp"
 #include "control/frames.hpp"
 
 namespace imd::control {
@@ -55,7 +55,7 @@ struct IolOutput {
 template <typename T>
 class Iol {
  public:
-  Iol(const ExactModel001Coefficients& c, const IolConfig& config) noexcept
+  Iol(const CurrentFedCoefficients& c, const IolConfig& config) noexcept
       : e_(T(c.flux_decay)),
         c_(T(c.flux_from_i_now_H)),
         ls_sigma_(T(c.flux_from_i_next_H)),

@@ -9,7 +9,7 @@
 #include <Eigen/Core>
 #include <complex>
 
-#include "control/exact_model_000.hpp"
+#include "control/voltage_fed_model.hpp"
 #include "control/frames.hpp"
 
 namespace imd::control {
@@ -21,7 +21,7 @@ struct LoadEstimatorGains {
 
 /// Gains that give the error matrix of (13) the poles z1, z2 (real, |z| < 1):
 /// trace 1 - l1 = z1 + z2 and determinant -l1 + g l2 = z1 z2.
-inline LoadEstimatorGains place_load_estimator(const ExactModel000Coefficients& c, double z1,
+inline LoadEstimatorGains place_load_estimator(const VoltageFedCoefficients& c, double z1,
                                                double z2) {
   LoadEstimatorGains gains;
   gains.l1 = 1.0 - (z1 + z2);
@@ -30,7 +30,7 @@ inline LoadEstimatorGains place_load_estimator(const ExactModel000Coefficients& 
 }
 
 /// The error matrix of (13) for given gains.
-inline Eigen::Matrix2d load_estimator_error_matrix(const ExactModel000Coefficients& c,
+inline Eigen::Matrix2d load_estimator_error_matrix(const VoltageFedCoefficients& c,
                                                    const LoadEstimatorGains& gains) {
   Eigen::Matrix2d m;
   m << -gains.l1, c.load_to_omega, -gains.l2, 1.0;
@@ -40,7 +40,7 @@ inline Eigen::Matrix2d load_estimator_error_matrix(const ExactModel000Coefficien
 template <typename T>
 class LoadEstimator {
  public:
-  LoadEstimator(const ExactModel000Coefficients& c, const LoadEstimatorGains& gains) noexcept
+  LoadEstimator(const VoltageFedCoefficients& c, const LoadEstimatorGains& gains) noexcept
       : eta1_(T(c.eta1)),
         eta2_(T(c.eta2)),
         eta3_(T(c.eta3)),

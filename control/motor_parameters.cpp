@@ -4,8 +4,8 @@
 
 namespace imd::control {
 
-Seed000Constants derive_seed000(const MotorParameters& m) noexcept {
-  Seed000Constants c;
+VoltageFedConstants derive_voltage_fed(const MotorParameters& m) noexcept {
+  VoltageFedConstants c;
   c.sigma_H = m.Ls_H - m.Lm_H * m.Lm_H / m.Lr_H;
   c.alpha_per_s = m.Rr_Ohm / m.Lr_H;
   c.beta_per_H = m.Lm_H / (c.sigma_H * m.Lr_H);
@@ -14,8 +14,8 @@ Seed000Constants derive_seed000(const MotorParameters& m) noexcept {
   return c;
 }
 
-Seed001Constants derive_seed001(const MotorParameters& m) noexcept {
-  Seed001Constants c;
+CurrentFedConstants derive_current_fed(const MotorParameters& m) noexcept {
+  CurrentFedConstants c;
   c.sigma = 1.0 - m.Lm_H * m.Lm_H / (m.Lr_H * m.Ls_H);
   c.eta_per_s = m.Rr_Ohm / m.Lr_H;
   c.zeta_per_H_s = m.Rr_Ohm / (c.sigma * m.Lr_H * m.Ls_H);

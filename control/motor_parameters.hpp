@@ -27,7 +27,7 @@ struct MotorParameters {
 };
 
 /// Constants of model (1) of paper 000.
-struct Seed000Constants {
+struct VoltageFedConstants {
   double sigma_H = 0.0;      ///< sigma = Ls - Lm^2/Lr (stator transient inductance)
   double alpha_per_s = 0.0;  ///< alpha = Rr/Lr
   double beta_per_H = 0.0;   ///< beta = Lm/(sigma Lr)
@@ -36,7 +36,7 @@ struct Seed000Constants {
 };
 
 /// Constants of model (1) of paper 001 (stator flux and stator current as states).
-struct Seed001Constants {
+struct CurrentFedConstants {
   double sigma = 0.0;         ///< leakage factor 1 - m^2/(lr ls), dimensionless
   double eta_per_s = 0.0;     ///< eta = rr/lr
   double zeta_per_H_s = 0.0;  ///< zeta = rr/(sigma lr ls)
@@ -44,10 +44,10 @@ struct Seed001Constants {
 };
 
 /// Paper 000 constants. Requires valid parameters (see find_invalid_parameter).
-Seed000Constants derive_seed000(const MotorParameters& motor) noexcept;
+VoltageFedConstants derive_voltage_fed(const MotorParameters& motor) noexcept;
 
 /// Paper 001 constants. Requires valid parameters (see find_invalid_parameter).
-Seed001Constants derive_seed001(const MotorParameters& motor) noexcept;
+CurrentFedConstants derive_current_fed(const MotorParameters& motor) noexcept;
 
 /// The first parameter that makes a motor invalid, with the rule it breaks.
 struct ParameterProblem {

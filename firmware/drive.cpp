@@ -35,7 +35,7 @@ Drive<T>::Drive(const control::MotorParameters& motor, const DriveConfig& config
       commanded_(T(config.flux2_ref_Wb2), T(config.stator_flux2_ref_Wb2)),
       references_(config.commands_over_can ? commanded_ : references),
       oracle_(oracle),
-      coefficients_(control::discretize_seed000(motor, config.sample_period_s)),
+      coefficients_(control::discretize_voltage_fed(motor, config.sample_period_s)),
       model_(coefficients_),
       dsmc_(coefficients_, control::DsmcConfig{config.min_flux2_Wb2, config.speed_reaching_pole,
                                                config.flux_reaching_pole}),
@@ -55,13 +55,13 @@ Drive<T>::Drive(const control::MotorParameters& motor, const DriveConfig& config
                       motor.J_kgm2, motor.friction_Nms, config.protection.encoder_missing_counts,
                       config.protection.encoder_window_s, config.protection.overspeed_rad_s}),
       adc_stuck_check_(config.protection.adc_stuck_ticks, config.sample_period_s,
-                       control::derive_seed000(motor).sigma_H,
+                       control::derive_voltage_fed(motor).sigma_H,
                        double(peripherals.adc.scale().phase_A_per_code)),
       phase_loss_check_(config.protection.phase_loss_ratio,
                         config.protection.phase_loss_min_current_A,
                         static_cast<uint32_t>(ticks(config.protection.phase_loss_max_window_s,
                                                     config.sample_period_s))) {
-  const control::Seed000Constants k = control::derive_seed000(motor);
+  const control::VoltageFedConstants k = control::derive_voltage_fed(motor);
   sigma_H_ = T(k.sigma_H);
   beta_per_H_ = T(k.beta_per_H);
   pole_pairs_ = T(motor.pole_pairs);
@@ -211,7 +211,7 @@ typename Drive<T>::Estimate Drive<T>::estimate(const hal::AdcSample& sample) noe
 
   if (oracle_ != nullptr) {  // ideal sensors: current, speed and position are measured exactly
     const TrueState<T> truth = oracle_->true_state();
-    e.x.i_s_AB_A = Vec2(truth.i_s_A_A, truth.i_s_B_A);
+    e.x.i_s_AB_A = Vec2(truth.iA_s_A, truth.iB_s_A);
     adc_saturated_ = false;  // the ADC is not used
     const auto true_abc = control::inverse_clarke(
         Vec2(control::Rotation<T>::from_angle(pole_pairs_ * truth.theta_mech_rad)
@@ -372,8 +372,8 @@ control::Vec2<T> Drive<T>::control(uint64_t k, const Estimate& e, T v_bus_V) noe
         iol_stage_.tick(e.x.flux_r_AB_Wb, e.x.omega_mech_rad_s, boundary_ref);
     if (r.status != control::IolStatus::ok) trip(FaultCode::singular_control, k);
     i_command = r.i_cmd_AB_A;
-    record_.i_held_A_A = r.i_held_AB_A.x();
-    record_.i_held_B_A = r.i_held_AB_A.y();
+    record_.iA_held_A = r.i_held_AB_A.x();
+    record_.iB_held_A = r.i_held_AB_A.y();
     v = current_loop_.input(x.flux_r_AB_Wb, x.i_s_AB_A, i_command, feasible);
     record_.iol_boundary = r.boundary;
     if (r.boundary) {
@@ -410,8 +410,8 @@ control::Vec2<T> Drive<T>::control(uint64_t k, const Estimate& e, T v_bus_V) noe
 
   // --- inner feedback (2) and limits. The held voltage is rotated to the middle of the
   // period it acts on, where the analog law's rotation is on average.
-  record_.i_cmd_A_A = i_command.x();
-  record_.i_cmd_B_A = i_command.y();
+  record_.iA_cmd_A = i_command.x();
+  record_.iB_cmd_A = i_command.y();
   if (config_.current_source) {
     if (!finite(i_command)) trip(FaultCode::non_finite, k);
     if (machine_.state() != DriveState::fault && hw_.current_source != nullptr) {
@@ -518,8 +518,8 @@ void Drive<T>::on_tick() noexcept {
     record_.flux2_est_Wb2 = e.x.flux_r_AB_Wb.squaredNorm();
     record_.controlled_flux2_Wb2 = magnetized_flux2(e.x);
     record_.load_est_Nm = e.load_Nm;
-    record_.i_A_A = e.x.i_s_AB_A.x();
-    record_.i_B_A = e.x.i_s_AB_A.y();
+    record_.iA_A = e.x.i_s_AB_A.x();
+    record_.iB_A = e.x.i_s_AB_A.y();
     record_.v_bus_V = v_bus_V;
     record_.v_A_V = v.x();
     record_.v_B_V = v.y();

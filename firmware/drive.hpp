@@ -14,7 +14,7 @@
 #include "control/deadbeat_current.hpp"
 #include "control/dsmc.hpp"
 #include "control/encoder_observer.hpp"
-#include "control/exact_model_000.hpp"
+#include "control/voltage_fed_model.hpp"
 #include "control/flux_observer.hpp"
 #include "control/load_estimator.hpp"
 #include "control/motor_parameters.hpp"
@@ -137,8 +137,8 @@ class Drive final : public hal::TickHandler {
   const ReferenceSource<T>& references_;  ///< commanded_ or the profile given at construction
   const StateOracle<T>* oracle_;
 
-  control::ExactModel000Coefficients coefficients_;
-  control::ExactModel000<T> model_;
+  control::VoltageFedCoefficients coefficients_;
+  control::VoltageFedModel<T> model_;
   control::Dsmc<T> dsmc_;
   control::FluxObserver<T> flux_observer_;
   control::EncoderObserver<T> encoder_observer_;

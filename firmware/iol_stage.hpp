@@ -8,7 +8,7 @@
 #include <cmath>
 #include <cstdint>
 
-#include "control/exact_model_001.hpp"
+#include "control/current_fed_model.hpp"
 #include "control/flux_outer_loop.hpp"
 #include "control/frames.hpp"
 #include "control/iol.hpp"
@@ -35,7 +35,7 @@ template <typename T>
 class IolStage {
  public:
   IolStage(const control::MotorParameters& motor, const DriveConfig& config)
-      : coefficients_(control::discretize_seed001(motor, config.iol_period_s)),
+      : coefficients_(control::discretize_current_fed(motor, config.iol_period_s)),
         law_(coefficients_, control::IolConfig{}),
         flux_loop_(coefficients_.flux_decay,
                    control::place_flux_outer_loop(coefficients_.flux_decay, config.iol_period_s,
@@ -51,7 +51,7 @@ class IolStage {
         Lm_over_Lr_(T(motor.Lm_H / motor.Lr_H)),
         one_minus_flux_decay_(T(1) - T(coefficients_.flux_decay)) {}
 
-  const control::ExactModel001Coefficients& coefficients() const noexcept { return coefficients_; }
+  const control::CurrentFedCoefficients& coefficients() const noexcept { return coefficients_; }
   int ticks_per_period() const noexcept { return ticks_per_period_; }
 
   /// Starts the law with this current held (the magnetizing current).
@@ -102,7 +102,7 @@ class IolStage {
   }
 
  private:
-  control::ExactModel001Coefficients coefficients_;
+  control::CurrentFedCoefficients coefficients_;
   control::Iol<T> law_;
   control::FluxOuterLoop<T> flux_loop_;
   control::SpeedPi<T> speed_pi_;

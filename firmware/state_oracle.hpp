@@ -7,7 +7,7 @@ namespace imd::firmware {
 template <typename T>
 struct TrueState {
   T flux_r_A_Wb = T(0), flux_r_B_Wb = T(0);
-  T i_s_A_A = T(0), i_s_B_A = T(0);
+  T iA_s_A = T(0), iB_s_A = T(0);
   T omega_mech_rad_s = T(0);
   T theta_mech_rad = T(0);
   T load_Nm = T(0);

@@ -72,7 +72,7 @@ void Telemetry::publish(uint64_t k, hal::CanBus& can, const TickRecord<T>& r,
                             float(r.controlled_flux2_Wb2), float(r.controlled_flux2_ref_Wb2)}));
     send(can,
          encode_frame(node_id_, MessageId::telemetry_current,
-                      {float(r.i_A_A), float(r.i_B_A), float(r.load_est_Nm), float(r.v_bus_V)}));
+                      {float(r.iA_A), float(r.iB_A), float(r.load_est_Nm), float(r.v_bus_V)}));
     send(can, encode_frame(node_id_, MessageId::telemetry_voltage,
                            {float(r.u_alpha_V), float(r.u_beta_V), float(sample_count_++)}));
   }

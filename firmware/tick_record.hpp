@@ -18,7 +18,7 @@ struct TickRecord {
   T omega_est_rad_s = T(0), theta_est_rad = T(0), flux2_est_Wb2 = T(0), load_est_Nm = T(0);
   T flux_est_A_Wb = T(0), flux_est_B_Wb = T(0);
   T i_alpha_A = T(0), i_beta_A = T(0), v_bus_V = T(0);
-  T i_A_A = T(0), i_B_A = T(0);  ///< estimated stator current, rotor frame
+  T iA_A = T(0), iB_A = T(0);  ///< estimated stator current, rotor frame
   // References the law aimed at (for the step the input acts on).
   T omega_ref_rad_s = T(0), flux2_ref_Wb2 = T(0);
   /// The flux the selected controller regulates: rotor flux (dsmc) or stator flux (iol).
@@ -30,8 +30,8 @@ struct TickRecord {
   // The current-fed controller (iol), at its last T0 boundary.
   T torque_ref_Nm = T(0), torque_cmd_Nm = T(0), y2 = T(0), y2_ref = T(0);
   T stator_flux2_est_Wb2 = T(0);
-  T i_cmd_A_A = T(0), i_cmd_B_A = T(0);    ///< rotor-frame current command
-  T i_held_A_A = T(0), i_held_B_A = T(0);  ///< iol: the current the law assumes held now
+  T iA_cmd_A = T(0), iB_cmd_A = T(0);    ///< rotor-frame current command
+  T iA_held_A = T(0), iB_held_A = T(0);  ///< iol: the current the law assumes held now
   bool torque_limited = false;
   bool iol_boundary = false;  ///< the IOL law ran this tick
   bool speed_saturated = false, flux_saturated = false, voltage_clipped = false;

@@ -14,10 +14,10 @@ class CurrentSource {
 
  public:
   /// Sets the rotor-frame stator current from the next period on. Tick context.
-  virtual void set_current_AB_A(double i_A_A, double i_B_A) noexcept = 0;
+  virtual void set_current_AB_A(double iA_A, double iB_A) noexcept = 0;
   /// The same from a single-precision drive: the device converts, so that the drive's tick
   /// converts nothing (the MCU has no double-precision FPU).
-  virtual void set_current_AB_A(float i_A_A, float i_B_A) noexcept = 0;
+  virtual void set_current_AB_A(float iA_A, float iB_A) noexcept = 0;
 };
 
 }  // namespace imd::hal

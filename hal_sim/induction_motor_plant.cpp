@@ -37,7 +37,7 @@ Vec2 phase_axis(int phase) noexcept {
 
 InductionMotorPlant::InductionMotorPlant(const control::MotorParameters& motor,
                                          const PlantConfig& config)
-    : motor_(motor), k_(control::derive_seed000(motor)), config_(config) {
+    : motor_(motor), k_(control::derive_voltage_fed(motor)), config_(config) {
   assert(config.period_s > 0.0 && config.rk4_substeps >= 1);
 }
 
@@ -107,7 +107,7 @@ void InductionMotorPlant::step_voltage(const Vec2& u_s_alphabeta_V, double load_
 namespace {
 
 /// Feedback (2): u = sigma p w J (I + beta Phi) + e^{p th J} v~.
-Vec2 feedback_2(const control::Seed000Constants& k, int pole_pairs, const Vec2& flux,
+Vec2 feedback_2(const control::VoltageFedConstants& k, int pole_pairs, const Vec2& flux,
                 const Vec2& current, double omega, double theta, const Vec2& v_AB_V) {
   const double p = pole_pairs;
   return k.sigma_H * p * omega * control::J_times<double>(current + k.beta_per_H * flux) +

@@ -107,7 +107,7 @@ class InductionMotorPlant {
   Vec2 constrained(const Vec2& current) const noexcept;
 
   control::MotorParameters motor_;
-  control::Seed000Constants k_;
+  control::VoltageFedConstants k_;
   PlantConfig config_;
   PlantState state_;
   double time_s_ = 0.0;

@@ -37,7 +37,7 @@ void SimBoard::end_period() {
   const double load_now_Nm = load_Nm();
   // What the firmware wrote this tick acts now (no latency) or from the next tick.
   const Vec2 written_analog(analog_.v_A_V(), analog_.v_B_V());
-  const Vec2 written_current(current_source_.i_A_A(), current_source_.i_B_A());
+  const Vec2 written_current(current_source_.iA_A(), current_source_.iB_A());
   if (config_.pwm_latency_ticks == 0) {
     active_duty_ = pwm_.written();
     active_analog_input_V_ = written_analog;

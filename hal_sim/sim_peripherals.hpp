@@ -175,18 +175,18 @@ class SimAnalogInnerLoop final : public hal::AnalogInnerLoop {
 /// The ideal current source of paper 001; the board reads the latest current.
 class SimCurrentSource final : public hal::CurrentSource {
  public:
-  void set_current_AB_A(double i_A_A, double i_B_A) noexcept override {
-    i_A_A_ = i_A_A;
-    i_B_A_ = i_B_A;
+  void set_current_AB_A(double iA_A, double iB_A) noexcept override {
+    iA_A_ = iA_A;
+    iB_A_ = iB_A;
   }
-  void set_current_AB_A(float i_A_A, float i_B_A) noexcept override {
-    set_current_AB_A(double(i_A_A), double(i_B_A));
+  void set_current_AB_A(float iA_A, float iB_A) noexcept override {
+    set_current_AB_A(double(iA_A), double(iB_A));
   }
-  double i_A_A() const noexcept { return i_A_A_; }
-  double i_B_A() const noexcept { return i_B_A_; }
+  double iA_A() const noexcept { return iA_A_; }
+  double iB_A() const noexcept { return iB_A_; }
 
  private:
-  double i_A_A_ = 0.0, i_B_A_ = 0.0;
+  double iA_A_ = 0.0, iB_A_ = 0.0;
 };
 
 }  // namespace imd::sim

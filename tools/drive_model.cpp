@@ -11,8 +11,8 @@
 #include <iostream>
 #include <string>
 
-#include "control/exact_model_000.hpp"
-#include "control/exact_model_001.hpp"
+#include "control/voltage_fed_model.hpp"
+#include "control/current_fed_model.hpp"
 #include "hal_sim/config_error.hpp"
 #include "hal_sim/motor_file.hpp"
 
@@ -34,9 +34,9 @@ ordered_json motor_json(const MotorParameters& m) {
           {"friction_Nms", m.friction_Nms}};
 }
 
-ordered_json seed000_json(const MotorParameters& m, double delta_s) {
-  const auto k = imd::control::derive_seed000(m);
-  const auto c = imd::control::discretize_seed000(m, delta_s);
+ordered_json voltage_fed_json(const MotorParameters& m, double delta_s) {
+  const auto k = imd::control::derive_voltage_fed(m);
+  const auto c = imd::control::discretize_voltage_fed(m, delta_s);
   return {{"sample_period_s", c.delta_s},
           {"sigma_H", k.sigma_H},
           {"alpha_per_s", k.alpha_per_s},
@@ -61,9 +61,9 @@ ordered_json seed000_json(const MotorParameters& m, double delta_s) {
           {"load_to_theta", c.load_to_theta}};
 }
 
-ordered_json seed001_json(const MotorParameters& m, double T0_s) {
-  const auto k = imd::control::derive_seed001(m);
-  const auto c = imd::control::discretize_seed001(m, T0_s);
+ordered_json current_fed_json(const MotorParameters& m, double T0_s) {
+  const auto k = imd::control::derive_current_fed(m);
+  const auto c = imd::control::discretize_current_fed(m, T0_s);
   return {{"control_period_s", c.T0_s},
           {"sigma", k.sigma},
           {"eta_per_s", k.eta_per_s},
@@ -100,7 +100,7 @@ int main(int argc, char** argv) {
   double delta_s = 1e-4;
   double T0_s = 1e-3;
   CLI::App* discretize = app.add_subcommand(
-      "discretize", "Print the seed000 (paper 000) and seed001 (paper 001) coefficients as JSON");
+      "discretize", "Print the voltage-fed (paper 000) and current-fed (paper 001) coefficients as JSON");
   discretize->add_option("--motor", motor_path, "Motor file (TOML with a [motor] table)")
       ->required();
   discretize->add_option("--sample-period-s", delta_s, "Sample period delta of the paper-000 model")
@@ -121,8 +121,8 @@ int main(int argc, char** argv) {
     const MotorParameters motor = imd::sim::load_motor_file(motor_path);
     const ordered_json out = {{"motor_file", motor_path},
                               {"motor", motor_json(motor)},
-                              {"seed000", seed000_json(motor, delta_s)},
-                              {"seed001", seed001_json(motor, T0_s)}};
+                              {"voltage_fed", voltage_fed_json(motor, delta_s)},
+                              {"current_fed", current_fed_json(motor, T0_s)}};
     std::cout << out.dump(2) << '\n';
   } catch (const imd::sim::ConfigError& error) {
     std::cerr << "drive_model: " << error.what() << '\n';

@@ -168,8 +168,8 @@ inline constexpr Signal kSpeedFluxSignals[] = {
     {"flux2_ref_Wb2", 48, 16, false, 1, 10000, 0.0f, "Wb^2", "squared flux reference"},
 };
 inline constexpr Signal kCurrentSignals[] = {
-    {"i_A_A", 0, 16, true, 1, 100, 0.0f, "A", "stator current, rotor frame, A axis"},
-    {"i_B_A", 16, 16, true, 1, 100, 0.0f, "A", "stator current, rotor frame, B axis"},
+    {"iA_A", 0, 16, true, 1, 100, 0.0f, "A", "stator current, rotor frame, A axis"},
+    {"iB_A", 16, 16, true, 1, 100, 0.0f, "A", "stator current, rotor frame, B axis"},
     {"load_Nm", 32, 16, true, 1, 100, 0.0f, "N.m", "estimated load torque"},
     {"v_bus_V", 48, 16, false, 1, 10, 0.0f, "V", "measured DC bus"},
 };

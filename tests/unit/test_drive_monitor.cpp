@@ -88,7 +88,7 @@ TEST(drive_monitor_rows, EmitsARowWhenTheVoltageFrameArrives) {
   EXPECT_DOUBLE_EQ(row->speed_rad_s, 12345 * 0.01);
   EXPECT_DOUBLE_EQ(row->speed_ref_rad_s, 100.0);
   EXPECT_DOUBLE_EQ(row->flux2_Wb2, 8100 * 1e-4);
-  EXPECT_DOUBLE_EQ(row->i_A_A, -123 * 0.01);
+  EXPECT_DOUBLE_EQ(row->iA_A, -123 * 0.01);
   EXPECT_DOUBLE_EQ(row->v_bus_V, 3001 * 0.1);
   EXPECT_DOUBLE_EQ(row->u_beta_V, -456 * 0.1);
   EXPECT_EQ(row->sample, 42);
@@ -103,7 +103,7 @@ TEST(drive_monitor_rows, EmitsARowWhenTheVoltageFrameArrives) {
 
 TEST(drive_monitor_rows, CsvHeaderNamesTheColumns) {
   EXPECT_EQ(csv_header(),
-            "time_s,speed_rad_s,speed_ref_rad_s,flux2_Wb2,flux2_ref_Wb2,i_A_A,i_B_A,load_Nm,"
+            "time_s,speed_rad_s,speed_ref_rad_s,flux2_Wb2,flux2_ref_Wb2,iA_A,iB_A,load_Nm,"
             "v_bus_V,u_alpha_V,u_beta_V,sample,state,first_fault");
 }
 
@@ -120,7 +120,7 @@ TEST(drive_monitor_rows, CombinesTheLatestValuesAndCountsStaleAndIncompleteSampl
   const auto second = monitor.feed(0.02, voltage(3.0f));
   ASSERT_TRUE(second);
   EXPECT_DOUBLE_EQ(second->speed_rad_s, 2.0);
-  EXPECT_DOUBLE_EQ(second->i_A_A, 1.0);
+  EXPECT_DOUBLE_EQ(second->iA_A, 1.0);
   EXPECT_EQ(monitor.status().frames.stale_samples, 1u);
   EXPECT_EQ(monitor.status().frames.rows, 2u);
 }

@@ -6,7 +6,7 @@
 #include <cmath>
 
 #include "control/dsmc.hpp"
-#include "control/exact_model_000.hpp"
+#include "control/voltage_fed_model.hpp"
 #include "test_motors.hpp"
 
 namespace imd::control {
@@ -17,8 +17,8 @@ constexpr double kDelta_s = 1e-4;
 class DsmcTest : public ::testing::Test {
  protected:
   MotorParameters motor = test::test_motors()[0].parameters;  // paper 000 motor
-  ExactModel000Coefficients coefficients = discretize_seed000(motor, kDelta_s);
-  ExactModel000<double> model{coefficients};
+  VoltageFedCoefficients coefficients = discretize_voltage_fed(motor, kDelta_s);
+  VoltageFedModel<double> model{coefficients};
   Dsmc<double> dsmc{coefficients, DsmcConfig{}};
 
   /// A magnetized running state: flux 0.2 Wb^2 along A, a torque-producing current.

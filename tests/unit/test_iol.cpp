@@ -7,7 +7,7 @@
 #include <numbers>
 #include <random>
 
-#include "control/exact_model_001.hpp"
+#include "control/current_fed_model.hpp"
 #include "control/iol.hpp"
 #include "test_motors.hpp"
 
@@ -19,8 +19,8 @@ constexpr double kT0_s = 1e-3;
 class IolTest : public ::testing::Test {
  protected:
   MotorParameters motor = test::test_motors()[1].parameters;  // paper 001's 37 kW motor
-  ExactModel001Coefficients coefficients = discretize_seed001(motor, kT0_s);
-  ExactModel001<double> model{coefficients};
+  CurrentFedCoefficients coefficients = discretize_current_fed(motor, kT0_s);
+  CurrentFedModel<double> model{coefficients};
   Iol<double> iol{coefficients, IolConfig{}};
 
   /// A magnetized operating point: stator flux ~0.9 Wb, 100 A of torque-producing current.

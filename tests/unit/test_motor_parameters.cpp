@@ -16,9 +16,9 @@ const MotorParameters kPaper000{14.0, 0.4, 0.377, 10.1, 0.4128, 0.01, 1, 0.0};
 // within a few ulp of the true value, so 1e-14 relative is a safe bound.
 constexpr double kRoundoff = 1e-14;
 
-TEST(MotorParameters, Seed000ConstantsOfThePaperMotor) {
+TEST(MotorParameters, VoltageFedConstantsOfThePaperMotor) {
   // Reference values evaluated independently (Python, double) from the formulas under (1).
-  const Seed000Constants k = derive_seed000(kPaper000);
+  const VoltageFedConstants k = derive_voltage_fed(kPaper000);
   EXPECT_NEAR(k.sigma_H, 0.055695251937984525, kRoundoff * 0.0557);
   EXPECT_NEAR(k.alpha_per_s, 24.467054263565892, kRoundoff * 24.5);
   EXPECT_NEAR(k.beta_per_H, 16.39772084728806, kRoundoff * 16.4);
@@ -26,8 +26,8 @@ TEST(MotorParameters, Seed000ConstantsOfThePaperMotor) {
   EXPECT_NEAR(k.mu_per_kgm2, 136.99127906976744, kRoundoff * 137.0);
 }
 
-TEST(MotorParameters, Seed001ConstantsOfThePaperMotor) {
-  const Seed001Constants k = derive_seed001(kPaper000);
+TEST(MotorParameters, CurrentFedConstantsOfThePaperMotor) {
+  const CurrentFedConstants k = derive_current_fed(kPaper000);
   EXPECT_NEAR(k.sigma, 0.1392381298449613, kRoundoff);
   EXPECT_NEAR(k.zeta_per_H_s, 439.3023356965767, kRoundoff * 440.0);
   EXPECT_NEAR(k.gamma_per_s, 427.08886085859666, kRoundoff * 428.0);
@@ -38,8 +38,8 @@ TEST(MotorParameters, PapersAgreeOnEveryMotor) {
   for (const auto& motor : test::test_motors()) {
     SCOPED_TRACE(motor.name);
     const MotorParameters& m = motor.parameters;
-    const Seed000Constants k0 = derive_seed000(m);
-    const Seed001Constants k1 = derive_seed001(m);
+    const VoltageFedConstants k0 = derive_voltage_fed(m);
+    const CurrentFedConstants k1 = derive_current_fed(m);
     EXPECT_NEAR(k1.sigma * m.Ls_H, k0.sigma_H, kRoundoff * k0.sigma_H);  // ls sigma = sigma_000
     EXPECT_DOUBLE_EQ(k1.eta_per_s, k0.alpha_per_s);                      // eta = alpha = Rr/Lr
     // gamma_001 = rs/(sigma ls) + rr/(sigma lr) exceeds gamma_000 by exactly alpha.

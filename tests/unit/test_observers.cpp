@@ -7,7 +7,7 @@
 #include <numbers>
 
 #include "control/encoder_observer.hpp"
-#include "control/exact_model_000.hpp"
+#include "control/voltage_fed_model.hpp"
 #include "control/flux_observer.hpp"
 #include "control/load_estimator.hpp"
 #include "test_motors.hpp"
@@ -24,7 +24,7 @@ double spectral_radius(const Eigen::MatrixXd& m) {
 TEST(LoadEstimator, PrintedPaperGainsAreNotSchurStable) {
   // Section V prints l1 = 50, l2 = -45.78. Against the error equation (13) for the paper motor
   // the matrix [[-50, -0.01], [45.78, 1]] has eigenvalues 0.99 and -49.99.
-  const auto c = discretize_seed000(test::test_motors()[0].parameters, kDelta_s);
+  const auto c = discretize_voltage_fed(test::test_motors()[0].parameters, kDelta_s);
   const Eigen::Matrix2d m = load_estimator_error_matrix(c, {50.0, -45.78});
   const Eigen::Vector2cd eigenvalues = m.eigenvalues();
   const double small = std::min(std::abs(eigenvalues(0)), std::abs(eigenvalues(1)));
@@ -35,7 +35,7 @@ TEST(LoadEstimator, PrintedPaperGainsAreNotSchurStable) {
 
 TEST(LoadEstimator, PlacedGainsGiveTheRequestedPoles) {
   for (const auto& motor : test::test_motors()) {
-    const auto c = discretize_seed000(motor.parameters, kDelta_s);
+    const auto c = discretize_voltage_fed(motor.parameters, kDelta_s);
     const auto gains = place_load_estimator(c, 0.99, 0.985);
     Eigen::Vector2cd poles = load_estimator_error_matrix(c, gains).eigenvalues();
     if (poles(0).real() < poles(1).real()) std::swap(poles(0), poles(1));
@@ -45,8 +45,8 @@ TEST(LoadEstimator, PlacedGainsGiveTheRequestedPoles) {
 }
 
 TEST(LoadEstimator, ConvergesToAStepOfLoadOnTheExactModel) {
-  const auto c = discretize_seed000(test::test_motors()[0].parameters, kDelta_s);
-  const ExactModel000<double> model(c);
+  const auto c = discretize_voltage_fed(test::test_motors()[0].parameters, kDelta_s);
+  const VoltageFedModel<double> model(c);
   LoadEstimator<double> estimator(c, place_load_estimator(c, 0.99, 0.99));
   RotorFrameState<double> x;
   x.flux_r_AB_Wb = {0.45, 0.0};
@@ -65,8 +65,8 @@ TEST(LoadEstimator, ConvergesToAStepOfLoadOnTheExactModel) {
 }
 
 TEST(FluxObserver, ErrorDecaysAsA11ToTheK) {
-  const auto c = discretize_seed000(test::test_motors()[0].parameters, kDelta_s);
-  const ExactModel000<double> model(c);
+  const auto c = discretize_voltage_fed(test::test_motors()[0].parameters, kDelta_s);
+  const VoltageFedModel<double> model(c);
   FluxObserver<double> observer(c);
   RotorFrameState<double> x;
   x.flux_r_AB_Wb = {0.4, -0.1};
@@ -84,7 +84,7 @@ TEST(FluxObserver, ErrorDecaysAsA11ToTheK) {
 
 TEST(EncoderObserver, PolesArePlaced) {
   for (const auto& motor : test::test_motors()) {
-    const auto c = discretize_seed000(motor.parameters, kDelta_s);
+    const auto c = discretize_voltage_fed(motor.parameters, kDelta_s);
     const Eigen::Vector3d gain = place_encoder_observer(c, 400.0);
     const Eigen::Matrix3d error = encoder_observer_error_matrix(c, gain);
     // A triple pole: the characteristic polynomial is (z - z0)^3; compare its coefficients
@@ -99,8 +99,8 @@ TEST(EncoderObserver, PolesArePlaced) {
 TEST(EncoderObserver, TracksSpeedAndLoadFromAQuantizedAngle) {
   // Exact model, a 8192-count encoder, constant input: speed and load must be recovered from
   // the quantized angle alone.
-  const auto c = discretize_seed000(test::test_motors()[0].parameters, kDelta_s);
-  const ExactModel000<double> model(c);
+  const auto c = discretize_voltage_fed(test::test_motors()[0].parameters, kDelta_s);
+  const VoltageFedModel<double> model(c);
   EncoderObserver<double> observer(c, {});
   RotorFrameState<double> x;
   x.flux_r_AB_Wb = {0.45, 0.0};

@@ -5,7 +5,7 @@
 #include <cmath>
 #include <vector>
 
-#include "control/exact_model_001.hpp"
+#include "control/current_fed_model.hpp"
 #include "control/flux_outer_loop.hpp"
 #include "control/speed_pi.hpp"
 #include "test_motors.hpp"
@@ -14,7 +14,7 @@ namespace imd::control {
 namespace {
 
 TEST(FluxOuterLoop, PlacesADoublePole) {
-  const auto c = discretize_seed001(test::test_motors()[1].parameters, 1e-3);
+  const auto c = discretize_current_fed(test::test_motors()[1].parameters, 1e-3);
   const auto gains = place_flux_outer_loop(c.flux_decay, 1e-3, 0.01);
   // Closed loop of F(k+1) = e F + v2, v2 = (1 - e) F_ref + Kp (F_ref - F) + I, I += Ki (F_ref - F).
   Eigen::Matrix2d loop;
@@ -94,8 +94,8 @@ TEST(FluxOuterLoop, StepRealisesTheDesignedClosedLoop) {
 TEST(SpeedPi, ClosedLoopOnTheExactSpeedModelRejectsALoadStep) {
   // The speed row of paper 001's exact model, torque applied one period late (y1(k+1) = v1(k)).
   const auto motor = test::test_motors()[1].parameters;
-  const auto c = discretize_seed001(motor, 1e-3);
-  const ExactModel001<double> model(c);
+  const auto c = discretize_current_fed(motor, 1e-3);
+  const CurrentFedModel<double> model(c);
   SpeedPi<double> pi(design_speed_pi(motor.J_kgm2, 50.0, 240.0, 1e-3));
   double omega = 0.0, torque = 0.0;
   for (int k = 0; k < 3000; ++k) {

@@ -4,8 +4,8 @@
 
 #include "control/deadbeat_current.hpp"
 #include "control/dsmc.hpp"
-#include "control/exact_model_000.hpp"
-#include "control/exact_model_001.hpp"
+#include "control/voltage_fed_model.hpp"
+#include "control/current_fed_model.hpp"
 #include "control/iol.hpp"
 
 namespace {
@@ -17,7 +17,7 @@ const imd::control::MotorParameters kPaper001{0.052, 0.03175, 0.031, 0.07, 0.032
 
 template <typename T>
 void BM_DsmcStep(benchmark::State& bench) {
-  const imd::control::Dsmc<T> law(imd::control::discretize_seed000(kPaper000, 1e-4), {});
+  const imd::control::Dsmc<T> law(imd::control::discretize_voltage_fed(kPaper000, 1e-4), {});
   imd::control::DsmcInput<T> in;
   in.flux_r_AB_Wb = {T(0.447), T(0.01)};
   in.i_s_AB_A = {T(1.19), T(2.0)};
@@ -35,7 +35,7 @@ BENCHMARK_TEMPLATE(BM_DsmcStep, float)->Name("BM_DsmcStep/float");
 
 template <typename T>
 void BM_IolStep(benchmark::State& bench) {
-  const imd::control::Iol<T> law(imd::control::discretize_seed001(kPaper001, 1e-3), {});
+  const imd::control::Iol<T> law(imd::control::discretize_current_fed(kPaper001, 1e-3), {});
   imd::control::IolInput<T> in;
   in.flux_s_AB_Wb = {T(0.9), T(0.05)};
   in.i_s_AB_A = {T(30), T(100)};
@@ -53,7 +53,7 @@ BENCHMARK_TEMPLATE(BM_IolStep, float)->Name("BM_IolStep/float");
 /// 2000 N m asked).
 template <typename T>
 void BM_IolStepGuarded(benchmark::State& bench) {
-  const auto c = imd::control::discretize_seed001(kPaper001, 1e-3);
+  const auto c = imd::control::discretize_current_fed(kPaper001, 1e-3);
   const imd::control::Iol<T> law(c, {});
   imd::control::IolInput<T> in;
   in.flux_s_AB_Wb = {T(0.9), T(0)};
@@ -72,7 +72,7 @@ BENCHMARK_TEMPLATE(BM_IolStepGuarded, float)->Name("BM_IolStepGuarded/float");
 
 template <typename T>
 void BM_DeadbeatCurrentStep(benchmark::State& bench) {
-  const imd::control::DeadbeatCurrent<T> loop(imd::control::discretize_seed000(kPaper001, 1e-4));
+  const imd::control::DeadbeatCurrent<T> loop(imd::control::discretize_voltage_fed(kPaper001, 1e-4));
   const Vec2<T> flux(T(0.9), T(0.02)), current(T(30), T(95)), target(T(31), T(100));
   const imd::control::InputDisk<T> feasible{Vec2<T>(T(-10), T(40)), T(300)};
   for (auto _ : bench) {

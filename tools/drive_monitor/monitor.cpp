@@ -68,8 +68,8 @@ constexpr std::size_t kSpeed = index_of(MessageId::telemetry_speed_flux, "speed_
 constexpr std::size_t kSpeedRef = index_of(MessageId::telemetry_speed_flux, "speed_ref_rad_s");
 constexpr std::size_t kFlux2 = index_of(MessageId::telemetry_speed_flux, "flux2_Wb2");
 constexpr std::size_t kFlux2Ref = index_of(MessageId::telemetry_speed_flux, "flux2_ref_Wb2");
-constexpr std::size_t kIA = index_of(MessageId::telemetry_current, "i_A_A");
-constexpr std::size_t kIB = index_of(MessageId::telemetry_current, "i_B_A");
+constexpr std::size_t kIA = index_of(MessageId::telemetry_current, "iA_A");
+constexpr std::size_t kIB = index_of(MessageId::telemetry_current, "iB_A");
 constexpr std::size_t kLoad = index_of(MessageId::telemetry_current, "load_Nm");
 constexpr std::size_t kVBus = index_of(MessageId::telemetry_current, "v_bus_V");
 constexpr std::size_t kUAlpha = index_of(MessageId::telemetry_voltage, "u_alpha_V");
@@ -83,8 +83,8 @@ constexpr const protocol::Signal* kColumns[] = {
     &signal_of(MessageId::telemetry_speed_flux, "speed_ref_rad_s"),
     &signal_of(MessageId::telemetry_speed_flux, "flux2_Wb2"),
     &signal_of(MessageId::telemetry_speed_flux, "flux2_ref_Wb2"),
-    &signal_of(MessageId::telemetry_current, "i_A_A"),
-    &signal_of(MessageId::telemetry_current, "i_B_A"),
+    &signal_of(MessageId::telemetry_current, "iA_A"),
+    &signal_of(MessageId::telemetry_current, "iB_A"),
     &signal_of(MessageId::telemetry_current, "load_Nm"),
     &signal_of(MessageId::telemetry_current, "v_bus_V"),
     &signal_of(MessageId::telemetry_voltage, "u_alpha_V"),
@@ -189,7 +189,7 @@ std::string csv_header() {
 
 std::string csv_row(const TelemetryRow& row) {
   const double values[] = {row.speed_rad_s, row.speed_ref_rad_s, row.flux2_Wb2, row.flux2_ref_Wb2,
-                           row.i_A_A,       row.i_B_A,           row.load_Nm,   row.v_bus_V,
+                           row.iA_A,       row.iB_A,           row.load_Nm,   row.v_bus_V,
                            row.u_alpha_V,   row.u_beta_V};
   static_assert(std::size(values) == std::size(kColumns));
   char time[32];
@@ -313,8 +313,8 @@ std::optional<TelemetryRow> DriveMonitor::on_voltage(double time_s, const Decode
   row.speed_ref_rad_s = sf.signals[telemetry::kSpeedRef].value;
   row.flux2_Wb2 = sf.signals[telemetry::kFlux2].value;
   row.flux2_ref_Wb2 = sf.signals[telemetry::kFlux2Ref].value;
-  row.i_A_A = cu.signals[telemetry::kIA].value;
-  row.i_B_A = cu.signals[telemetry::kIB].value;
+  row.iA_A = cu.signals[telemetry::kIA].value;
+  row.iB_A = cu.signals[telemetry::kIB].value;
   row.load_Nm = cu.signals[telemetry::kLoad].value;
   row.v_bus_V = cu.signals[telemetry::kVBus].value;
   row.u_alpha_V = d.signals[telemetry::kUAlpha].value;

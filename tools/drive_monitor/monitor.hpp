@@ -67,8 +67,8 @@ struct TelemetryRow {
   double speed_ref_rad_s = 0.0;
   double flux2_Wb2 = 0.0;
   double flux2_ref_Wb2 = 0.0;
-  double i_A_A = 0.0;
-  double i_B_A = 0.0;
+  double iA_A = 0.0;
+  double iB_A = 0.0;
   double load_Nm = 0.0;
   double v_bus_V = 0.0;
   double u_alpha_V = 0.0;

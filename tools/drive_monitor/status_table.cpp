@@ -98,8 +98,8 @@ void add_telemetry(std::string& out, const DriveStatus& status) {
                   value(kSf, "flux2_Wb2", r.flux2_Wb2),
                   value(kSf, "flux2_ref_Wb2", r.flux2_ref_Wb2)));
   add(out, "",
-      fmt::format("i_A {}, i_B {}, load {}, v_bus {}", value(kCu, "i_A_A", r.i_A_A),
-                  value(kCu, "i_B_A", r.i_B_A), value(kCu, "load_Nm", r.load_Nm),
+      fmt::format("i_A {}, i_B {}, load {}, v_bus {}", value(kCu, "iA_A", r.iA_A),
+                  value(kCu, "iB_A", r.iB_A), value(kCu, "load_Nm", r.load_Nm),
                   value(kCu, "v_bus_V", r.v_bus_V)));
   add(out, "",
       fmt::format("u_alpha {}, u_beta {}", value(kVo, "u_alpha_V", r.u_alpha_V),

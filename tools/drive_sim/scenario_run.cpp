@@ -5,7 +5,7 @@
 #include <cmath>
 #include <stdexcept>
 
-#include "control/exact_model_001.hpp"
+#include "control/current_fed_model.hpp"
 #include "control/frames.hpp"
 #include "firmware/drive.hpp"
 #include "firmware/sim/run_metrics.hpp"
@@ -64,7 +64,7 @@ Summary run(const Scenario& s, const RunCallbacks& callbacks) {
   double hold_sq = 0;
   uint64_t hold_count = 0;
   const bool iol = s.controller == "iol";
-  const double flux_decay = control::discretize_seed001(m, s.iol_period_s).flux_decay;
+  const double flux_decay = control::discretize_current_fed(m, s.iol_period_s).flux_decay;
   Vec2 boundary_flux_s = Vec2::Zero();       // true stator flux (rotor frame) at the last boundary
   double pending_torque_cmd = std::nan("");  // the law's v1, due at the next boundary
   struct {
@@ -152,7 +152,7 @@ Summary run(const Scenario& s, const RunCallbacks& callbacks) {
       // the law takes as held over it.
       const Vec2 i_AB = rotor.apply_inverse(board.start_current_alphabeta_A());
       row.i_hold_err_A = iol && rec.state == firmware::DriveState::running
-                             ? (i_AB - Vec2(rec.i_held_A_A, rec.i_held_B_A)).norm()
+                             ? (i_AB - Vec2(rec.iA_held_A, rec.iB_held_A)).norm()
                              : 0.0;
       if (iol && t_s > s.settle_s) {
         hold_sq += row.i_hold_err_A * row.i_hold_err_A;
@@ -166,8 +166,8 @@ Summary run(const Scenario& s, const RunCallbacks& callbacks) {
     row.omega_ref_cmd_rad_s = rec.omega_ref_rad_s;
     row.flux2_ctrl_est_Wb2 = rec.controlled_flux2_Wb2;
     row.flux2_ctrl_ref_Wb2 = rec.controlled_flux2_ref_Wb2;
-    row.i_A_est_A = rec.i_A_A;
-    row.i_B_est_A = rec.i_B_A;
+    row.iA_est_A = rec.iA_A;
+    row.iB_est_A = rec.iB_A;
     row.v_bus_meas_V = rec.v_bus_V;
     row.u_alpha_cmd_V = rec.u_alpha_V;
     row.u_beta_cmd_V = rec.u_beta_V;

@@ -32,7 +32,7 @@ struct SimRow {
   // What the drive's telemetry carries (the CAN round trip compares against these).
   double omega_ref_cmd_rad_s = 0.0;  ///< the speed reference the law aimed at (after the ramp)
   double flux2_ctrl_est_Wb2 = 0.0, flux2_ctrl_ref_Wb2 = 0.0;  ///< the controlled flux
-  double i_A_est_A = 0.0, i_B_est_A = 0.0;  ///< estimated stator current, rotor frame
+  double iA_est_A = 0.0, iB_est_A = 0.0;  ///< estimated stator current, rotor frame
   double v_bus_meas_V = 0.0;
   double u_alpha_cmd_V = 0.0, u_beta_cmd_V = 0.0;  ///< stator voltage command
   bool iol_boundary = false;

@@ -5,7 +5,7 @@
 #include <cmath>
 #include <vector>
 
-#include "control/exact_model_000.hpp"
+#include "control/voltage_fed_model.hpp"
 #include "hal_sim/scenario.hpp"
 #include "test_motors.hpp"
 #include "tools/drive_sim/scenario_run.hpp"
@@ -37,7 +37,7 @@ TEST(Seed000Paper, SectionIvObserversConverge) {
   const Scenario s = scenario(
       "seed000_paper.toml",
       {"observers.section_iv=true", "drive.max_accel_rad_s2=2000", "metrics.settle_s=0.5"});
-  const double a11 = control::discretize_seed000(s.motor, s.sample_period_s).a11;
+  const double a11 = control::discretize_voltage_fed(s.motor, s.sample_period_s).a11;
   std::vector<SimRow> rows;
   rows.reserve(80001);
   const Summary r = run_scenario(s, {[&](const SimRow& row) { rows.push_back(row); }, {}});

@@ -16,7 +16,7 @@
 namespace imd::control {
 
 /// The constant coefficients of the exact sampled model for one motor and sample period.
-struct ExactModel000Coefficients {
+struct VoltageFedCoefficients {
   double delta_s = 0.0;  ///< sample period
   // A_d = [a11 I, a12 I; a21 I, a22 I] and B_d = [b1 I; b2 I].
   double a11 = 0.0, a12 = 0.0, a21 = 0.0, a22 = 0.0;
@@ -37,11 +37,11 @@ struct ExactModel000Coefficients {
 /// Computes the coefficients numerically exactly from matrix exponentials (Eigen's
 /// MatrixFunctions). Not for tick context: call once at start-up. Requires valid parameters
 /// and delta_s > 0.
-ExactModel000Coefficients discretize_seed000(const MotorParameters& motor, double delta_s);
+VoltageFedCoefficients discretize_voltage_fed(const MotorParameters& motor, double delta_s);
 
 /// Generator of one axis of the rotor-frame dynamics (5) with the held input as a third state:
 /// d/dt (phi, i, v) = A3 (phi, i, v); A = A3 (x) I2 acts on both axes alike.
-Eigen::Matrix3d seed000_axis_generator(const MotorParameters& motor);
+Eigen::Matrix3d voltage_fed_axis_generator(const MotorParameters& motor);
 
 /// Additive second compound A^[2] of a 3x3 matrix, index pairs ordered (0,1), (0,2), (1,2).
 /// The 2x2 minors of exp(A t) are the entries of exp(A^[2] t).
@@ -67,9 +67,9 @@ struct MechanicalIncrement {
 /// evaluated as increments: the small terms (eta3 ~ 1e-9, kappa3 ~ 1e-13 for the paper motor)
 /// are not lost against w_k or th_k, and a caller may keep th wrapped.
 template <typename T>
-class ExactModel000 {
+class VoltageFedModel {
  public:
-  explicit ExactModel000(const ExactModel000Coefficients& c) noexcept
+  explicit VoltageFedModel(const VoltageFedCoefficients& c) noexcept
       : a11_(T(c.a11)),
         a12_(T(c.a12)),
         a21_(T(c.a21)),

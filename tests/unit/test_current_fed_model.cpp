@@ -7,7 +7,7 @@
 #include <numbers>
 #include <random>
 
-#include "control/exact_model_001.hpp"
+#include "control/current_fed_model.hpp"
 #include "hal_sim/induction_motor_plant.hpp"
 #include "test_motors.hpp"
 
@@ -49,16 +49,16 @@ Draw random_draw(std::mt19937_64& rng, const test::TestMotor& m) {
 Vec2<double> stator_flux_AB(const MotorParameters& m, const sim::PlantState& s,
                             const Vec2<double>& i_AB_A) {
   const auto rotor = Rotation<double>::from_angle(m.pole_pairs * s.theta_mech_rad);
-  const double sigma_H = derive_seed000(m).sigma_H;
+  const double sigma_H = derive_voltage_fed(m).sigma_H;
   return sigma_H * i_AB_A + m.Lm_H / m.Lr_H * rotor.apply_inverse(s.flux_r_alphabeta_Wb);
 }
 
-TEST(ExactModel001, OneStepMatchesTheCurrentFedPlant) {
+TEST(CurrentFedModel, OneStepMatchesTheCurrentFedPlant) {
   for (const auto& motor : test::test_motors()) {
     SCOPED_TRACE(motor.name);
     const MotorParameters& m = motor.parameters;
-    const auto coefficients = discretize_seed001(m, kT0_s);
-    const ExactModel001<double> model(coefficients);
+    const auto coefficients = discretize_current_fed(m, kT0_s);
+    const CurrentFedModel<double> model(coefficients);
     sim::InductionMotorPlant plant(m, {kT0_s / kSlices, kSubstepsPerSlice});
     std::mt19937_64 rng(1001);
     double worst_flux = 0, worst_speed = 0, worst_torque = 0;
@@ -98,14 +98,14 @@ TEST(ExactModel001, OneStepMatchesTheCurrentFedPlant) {
   }
 }
 
-TEST(ExactModel001, ZeroFrictionGivesThePapersLoadTerm) {
+TEST(CurrentFedModel, ZeroFrictionGivesThePapersLoadTerm) {
   // (18) with c = 0: the load enters as T0 / J, and the speed does not decay.
   MotorParameters m = test::test_motors()[1].parameters;
   m.friction_Nms = 0.0;
-  const auto c = discretize_seed001(m, kT0_s);
+  const auto c = discretize_current_fed(m, kT0_s);
   EXPECT_EQ(c.speed_decay, 1.0);
   EXPECT_DOUBLE_EQ(c.load_to_speed, -kT0_s / m.J_kgm2);
-  const double eta = derive_seed001(m).eta_per_s;
+  const double eta = derive_current_fed(m).eta_per_s;
   // The paper's form 1 - e^{-x} cancels for small x = eta T0 (2e-3 here): the reference itself
   // carries a relative error of about eps / x, so allow 4 eps / x.
   const double x = eta * kT0_s;
@@ -113,20 +113,20 @@ TEST(ExactModel001, ZeroFrictionGivesThePapersLoadTerm) {
               4.0 * std::numeric_limits<double>::epsilon() / x * c.torque_to_speed);
 }
 
-TEST(ExactModel001, CoefficientsAreContinuousWhereTheFormulasDivideByZero) {
+TEST(CurrentFedModel, CoefficientsAreContinuousWhereTheFormulasDivideByZero) {
   // (17) divides by J eta - c and (18) by c. Both limits must be finite and continuous.
   MotorParameters m = test::test_motors()[1].parameters;
-  const double eta = derive_seed001(m).eta_per_s;
+  const double eta = derive_current_fed(m).eta_per_s;
   m.friction_Nms = eta * m.J_kgm2;  // J eta = c exactly
-  const auto at = discretize_seed001(m, kT0_s);
+  const auto at = discretize_current_fed(m, kT0_s);
   // Limit: T0 e^{-eta T0} / J.
   const double limit = kT0_s * std::exp(-eta * kT0_s) / m.J_kgm2;
   EXPECT_NEAR(at.torque_to_speed, limit, 1e-14 * limit);
   m.friction_Nms *= 1.0 + 1e-9;
-  const auto near = discretize_seed001(m, kT0_s);
+  const auto near = discretize_current_fed(m, kT0_s);
   EXPECT_NEAR(near.torque_to_speed, limit, 1e-9 * limit);
   m.friction_Nms = 1e-300;
-  EXPECT_NEAR(discretize_seed001(m, kT0_s).load_to_speed, -kT0_s / m.J_kgm2,
+  EXPECT_NEAR(discretize_current_fed(m, kT0_s).load_to_speed, -kT0_s / m.J_kgm2,
               1e-15 * kT0_s / m.J_kgm2);
 }
 

@@ -8,8 +8,8 @@
 #include <random>
 #include <unsupported/Eigen/MatrixFunctions>
 
-#include "control/exact_model_000.hpp"
-#include "control/exact_model_001.hpp"
+#include "control/voltage_fed_model.hpp"
+#include "control/current_fed_model.hpp"
 #include "hal_sim/induction_motor_plant.hpp"
 #include "test_motors.hpp"
 
@@ -67,7 +67,7 @@ Draw random_draw(std::mt19937_64& rng, const test::TestMotor& m) {
 
 /// Size of the terms that make up the speed and position increments: the natural scale to
 /// judge an increment's error against (the increment itself can nearly cancel).
-MechanicalIncrement<double> increment_scale(const ExactModel000Coefficients& c, const Draw& d) {
+MechanicalIncrement<double> increment_scale(const VoltageFedCoefficients& c, const Draw& d) {
   const double flux = d.x.flux_r_AB_Wb.norm(), current = d.x.i_s_AB_A.norm(), v = d.v_AB_V.norm();
   const double omega = std::abs(d.x.omega_mech_rad_s), load = std::abs(d.load_Nm);
   return {std::abs(c.omega_decay_minus_one) * omega + std::abs(c.eta1) * current * flux +
@@ -78,12 +78,12 @@ MechanicalIncrement<double> increment_scale(const ExactModel000Coefficients& c, 
               std::abs(c.load_to_theta) * load};
 }
 
-TEST(ExactModel000, OneStepMatchesFineIntegrationOfThePlant) {
+TEST(VoltageFedModel, OneStepMatchesFineIntegrationOfThePlant) {
   for (const auto& motor : test::test_motors()) {
     SCOPED_TRACE(motor.name);
     const int p = motor.parameters.pole_pairs;
-    const auto coefficients = discretize_seed000(motor.parameters, kDelta_s);
-    const ExactModel000<double> model(coefficients);
+    const auto coefficients = discretize_voltage_fed(motor.parameters, kDelta_s);
+    const VoltageFedModel<double> model(coefficients);
     sim::InductionMotorPlant plant(motor.parameters, {kDelta_s, kFineSubsteps});
     std::mt19937_64 rng(2024);
     double worst_flux = 0, worst_current = 0, worst_speed = 0, worst_position = 0;
@@ -147,7 +147,7 @@ double simpson(const F& f, double delta, int n) {
   return sum * h / 3.0;
 }
 
-TEST(ExactModel000, CoefficientsMatchQuadratureOfTheMinors) {
+TEST(VoltageFedModel, CoefficientsMatchQuadratureOfTheMinors) {
   // An independent route to eta and kappa: integrate the 2x2 minors of exp(A3 u) (no compound
   // matrix, no block exponential) with Simpson's rule, whose error falls as n^-4. The hardest
   // integrand is kappa3's, which starts as u^2 (delta - u): with 400 intervals it is still off
@@ -156,11 +156,11 @@ TEST(ExactModel000, CoefficientsMatchQuadratureOfTheMinors) {
   // Left over is the rounding of the coefficients under test: 1e-12.
   for (const auto& motor : test::test_motors()) {
     SCOPED_TRACE(motor.name);
-    const auto c = discretize_seed000(motor.parameters, kDelta_s);
-    const double mu = derive_seed000(motor.parameters).mu_per_kgm2;
+    const auto c = discretize_voltage_fed(motor.parameters, kDelta_s);
+    const double mu = derive_voltage_fed(motor.parameters).mu_per_kgm2;
     const double f = motor.parameters.friction_Nms / motor.parameters.J_kgm2;
     using Matrix3l = Eigen::Matrix<long double, 3, 3>;
-    const Matrix3l a = seed000_axis_generator(motor.parameters).cast<long double>();
+    const Matrix3l a = voltage_fed_axis_generator(motor.parameters).cast<long double>();
     const auto minor = [&](double u, int j, int l) {
       const Matrix3l e = (a * static_cast<long double>(u)).exp();
       return static_cast<double>(e(0, j) * e(1, l) - e(0, l) * e(1, j));
@@ -186,28 +186,28 @@ TEST(ExactModel000, CoefficientsMatchQuadratureOfTheMinors) {
   }
 }
 
-TEST(ExactModel000, FluxObserverPoleIsInsideTheUnitCircle) {
+TEST(VoltageFedModel, FluxObserverPoleIsInsideTheUnitCircle) {
   // Section IV: the flux observer error obeys e_{k+1} = a11 e_k and needs |a11| < 1.
   for (const auto& motor : test::test_motors()) {
     for (const double delta_s : {1e-5, 1e-4, 1e-3, 1e-2}) {
-      const auto c = discretize_seed000(motor.parameters, delta_s);
+      const auto c = discretize_voltage_fed(motor.parameters, delta_s);
       EXPECT_GT(c.a11, 0.0) << motor.name;
       EXPECT_LT(std::abs(c.a11), 1.0) << motor.name << " delta " << delta_s;
     }
   }
 }
 
-TEST(ExactModel000, Eta1MatchesItsClosedForm) {
+TEST(VoltageFedModel, Eta1MatchesItsClosedForm) {
   // q = I~^T J Phi~ is multiplied by det exp(A2 t) = exp(t tr A2), so with c = 0
   // eta1 = mu (e^{delta tr A2} - 1) / tr A2, tr A2 = -alpha - gamma (paper motor, c = 0).
   // With friction f = c/J the integral carries the weight e^{-f (delta - t)}:
   // eta1 = mu e^{-f delta} delta phi1((tr A2 + f) delta).
   for (const auto& motor : test::test_motors()) {
     SCOPED_TRACE(motor.name);
-    const auto k = derive_seed000(motor.parameters);
+    const auto k = derive_voltage_fed(motor.parameters);
     const double trace = -k.alpha_per_s - k.gamma_per_s;
     const double f = motor.parameters.friction_Nms / motor.parameters.J_kgm2;
-    const auto c = discretize_seed000(motor.parameters, kDelta_s);
+    const auto c = discretize_voltage_fed(motor.parameters, kDelta_s);
     const double closed =
         k.mu_per_kgm2 * std::exp(-f * kDelta_s) * kDelta_s * phi1((trace + f) * kDelta_s);
     EXPECT_NEAR(c.eta1, closed, kExpmTolerance * std::abs(closed));
@@ -221,10 +221,10 @@ TEST(ExactModel000, Eta1MatchesItsClosedForm) {
   }
 }
 
-TEST(ExactModel000, CompoundMatrixGivesTheMinorsOfTheExponential) {
+TEST(VoltageFedModel, CompoundMatrixGivesTheMinorsOfTheExponential) {
   // The derivation rests on C2(exp(A t)) = exp(A^[2] t): check it against the 2x2 minors.
   for (const auto& motor : test::test_motors()) {
-    const Eigen::Matrix3d a = seed000_axis_generator(motor.parameters);
+    const Eigen::Matrix3d a = voltage_fed_axis_generator(motor.parameters);
     for (const double t : {1e-4, 1e-3, 2e-2}) {
       const Eigen::Matrix3d e = (a * t).exp();
       const Eigen::Matrix3d c = (additive_compound(a) * t).exp();
@@ -242,9 +242,9 @@ TEST(ExactModel000, CompoundMatrixGivesTheMinorsOfTheExponential) {
   }
 }
 
-TEST(ExactModel000, FrictionlessMechanicsReduceToThePaper) {
+TEST(VoltageFedModel, FrictionlessMechanicsReduceToThePaper) {
   const test::TestMotor motor = test::test_motors().front();  // seed000: c = 0
-  const auto c = discretize_seed000(motor.parameters, kDelta_s);
+  const auto c = discretize_voltage_fed(motor.parameters, kDelta_s);
   const double J = motor.parameters.J_kgm2;
   EXPECT_EQ(c.omega_decay, 1.0);
   EXPECT_NEAR(c.omega_to_theta_s, kDelta_s, 1e-16 * kDelta_s);
@@ -252,16 +252,16 @@ TEST(ExactModel000, FrictionlessMechanicsReduceToThePaper) {
   EXPECT_NEAR(c.load_to_theta, -kDelta_s * kDelta_s / (2 * J), 1e-15 * kDelta_s * kDelta_s / J);
 }
 
-TEST(ExactModel000, FloatPredictorStaysCloseToDouble) {
+TEST(VoltageFedModel, FloatPredictorStaysCloseToDouble) {
   // The MCU build runs the predictor in float. Each output is a short sum of products of
   // values of one magnitude, and the draws keep outputs away from zero, so the float result
   // is within a few float ulp (6e-8) of double: bound 1e-6, i.e. about 16 ulp. The increments
   // are checked the same way against the size of their terms: there the small eta3 and kappa3
   // terms must survive, which they would not if added to w_k or th_k in float.
   for (const auto& motor : test::test_motors()) {
-    const auto coefficients = discretize_seed000(motor.parameters, kDelta_s);
-    const ExactModel000<double> model_d(coefficients);
-    const ExactModel000<float> model_f(coefficients);
+    const auto coefficients = discretize_voltage_fed(motor.parameters, kDelta_s);
+    const VoltageFedModel<double> model_d(coefficients);
+    const VoltageFedModel<float> model_f(coefficients);
     std::mt19937_64 rng(7);
     for (int trial = 0; trial < 200; ++trial) {
       const Draw d = random_draw(rng, motor);

@@ -5,7 +5,7 @@
 #include <cmath>
 #include <vector>
 
-#include "control/exact_model_001.hpp"
+#include "control/current_fed_model.hpp"
 #include "firmware/drive_state.hpp"
 #include "hal_sim/scenario.hpp"
 #include "test_motors.hpp"
@@ -35,7 +35,7 @@ TEST(Seed001Paper, DecouplesExactlyAndSettlesTheFlux) {
 
   // (25): torque(k+1) = v1(k) and y2(k+1) = v2(k). The plant integrates the current-fed motor
   // with RK4 (h = 10 us) against the exact model; their one-step agreement is 1e-14
-  // (ExactModel001.OneStepMatchesTheCurrentFedPlant), so 1e-9 leaves room for 3000 steps of
+  // (CurrentFedModel.OneStepMatchesTheCurrentFedPlant), so 1e-9 leaves room for 3000 steps of
   // rounding. Torque errors are relative to max(|v1|, 1 N m): v1 is 0 before the step.
   double worst_torque = 0.0, worst_y2 = 0.0;
   for (std::size_t k = 1; k + 1 < boundaries.size(); ++k) {
@@ -68,7 +68,7 @@ TEST(Seed001Paper, DecouplesExactlyAndSettlesTheFlux) {
   const SimRow& before = boundaries[boundaries.size() - 2];
   const double slip_T0 =
       std::atan2(last.flux_B_Wb, last.flux_A_Wb) - std::atan2(before.flux_B_Wb, before.flux_A_Wb);
-  const double e = control::discretize_seed001(s.motor, s.iol_period_s).flux_decay;
+  const double e = control::discretize_current_fed(s.motor, s.iol_period_s).flux_decay;
   const double predicted = (1.0 - e) * s.stator_flux2_Wb2 / (std::cos(slip_T0) - e);
   const double excess = last.stator_flux2_Wb2 - s.stator_flux2_Wb2;
   EXPECT_GT(excess, 0.0);

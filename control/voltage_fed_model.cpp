@@ -1,4 +1,4 @@
-#include "control/exact_model_000.hpp"
+#include "control/voltage_fed_model.hpp"
 
 #include <Eigen/Core>
 #include <cmath>
@@ -6,8 +6,8 @@
 
 namespace imd::control {
 
-Eigen::Matrix3d seed000_axis_generator(const MotorParameters& motor) {
-  const Seed000Constants k = derive_seed000(motor);
+Eigen::Matrix3d voltage_fed_axis_generator(const MotorParameters& motor) {
+  const VoltageFedConstants k = derive_voltage_fed(motor);
   Eigen::Matrix3d a;
   a << -k.alpha_per_s, k.alpha_per_s * motor.Lm_H, 0.0,               //
       k.alpha_per_s * k.beta_per_H, -k.gamma_per_s, 1.0 / k.sigma_H,  //
@@ -23,15 +23,15 @@ Eigen::Matrix3d additive_compound(const Eigen::Matrix3d& a) {
   return m;
 }
 
-ExactModel000Coefficients discretize_seed000(const MotorParameters& motor, double delta_s) {
-  const Seed000Constants k = derive_seed000(motor);
+VoltageFedCoefficients discretize_voltage_fed(const MotorParameters& motor, double delta_s) {
+  const VoltageFedConstants k = derive_voltage_fed(motor);
   const double friction_per_s = motor.friction_Nms / motor.J_kgm2;
 
-  ExactModel000Coefficients c;
+  VoltageFedCoefficients c;
   c.delta_s = delta_s;
 
   // Electrical part: A_d and B_d are blocks of exp(A3 delta).
-  const Eigen::Matrix3d a3 = seed000_axis_generator(motor);
+  const Eigen::Matrix3d a3 = voltage_fed_axis_generator(motor);
   const Eigen::Matrix3d e3 = (a3 * delta_s).exp();
   c.a11 = e3(0, 0);
   c.a12 = e3(0, 1);

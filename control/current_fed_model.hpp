@@ -16,7 +16,7 @@
 namespace imd::control {
 
 /// Constant coefficients of the exact discrete model for one motor and period T0.
-struct ExactModel001Coefficients {
+struct CurrentFedCoefficients {
   double T0_s = 0.0;                   ///< control period
   double flux_decay = 0.0;             ///< e^{-eta T0}
   double flux_from_i_now_H = 0.0;      ///< ls (1 - sigma - e^{-eta T0}), multiplies i_k
@@ -31,16 +31,16 @@ struct ExactModel001Coefficients {
 
 /// Computes the coefficients in closed form, stable for c -> 0 and for J eta -> c. Requires
 /// valid parameters and T0_s > 0. Not for tick context.
-ExactModel001Coefficients discretize_seed001(const MotorParameters& motor, double T0_s);
+CurrentFedCoefficients discretize_current_fed(const MotorParameters& motor, double T0_s);
 
 /// (exp(x) - 1) / x, equal to 1 at x = 0, without cancellation for small |x|.
 double phi1(double x) noexcept;
 
 /// One-step maps of the exact discrete model, in float or double. Tick context.
 template <typename T>
-class ExactModel001 {
+class CurrentFedModel {
  public:
-  explicit ExactModel001(const ExactModel001Coefficients& c) noexcept
+  explicit CurrentFedModel(const CurrentFedCoefficients& c) noexcept
       : flux_decay_(T(c.flux_decay)),
         flux_from_i_now_H_(T(c.flux_from_i_now_H)),
         flux_from_i_next_H_(T(c.flux_from_i_next_H)),

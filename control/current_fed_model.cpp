@@ -1,4 +1,4 @@
-#include "control/exact_model_001.hpp"
+#include "control/current_fed_model.hpp"
 
 #include <cmath>
 
@@ -8,10 +8,10 @@ double phi1(double x) noexcept {
   return x == 0.0 ? 1.0 : std::expm1(x) / x;
 }
 
-ExactModel001Coefficients discretize_seed001(const MotorParameters& motor, double T0_s) {
-  const Seed001Constants k = derive_seed001(motor);
+CurrentFedCoefficients discretize_current_fed(const MotorParameters& motor, double T0_s) {
+  const CurrentFedConstants k = derive_current_fed(motor);
   const double friction_per_s = motor.friction_Nms / motor.J_kgm2;  // c / J
-  ExactModel001Coefficients c;
+  CurrentFedCoefficients c;
   c.T0_s = T0_s;
   c.eta_per_s = k.eta_per_s;
   c.flux_decay = std::exp(-k.eta_per_s * T0_s);
