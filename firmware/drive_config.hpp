@@ -8,17 +8,16 @@
 
 namespace imd::firmware {
 
-enum class ControllerKind {
+/// The control laws, by their number on CAN (firmware/laws/law_registry.hpp lists them).
+enum class ControllerKind : uint8_t {
   dsmc,  ///< paper 000: sliding modes on speed and rotor flux
   iol,   ///< paper 001: input-output linearization of torque and stator flux
 };
+inline constexpr int kControllerCount = 2;
 
 struct DriveConfig {
   double sample_period_s = 1e-4;  ///< control period delta
   ControllerKind controller = ControllerKind::dsmc;
-  /// Drive the analog inner-feedback device (paper's hybrid scheme) instead of running (2)
-  /// digitally through the PWM.
-  bool analog_inner_loop = false;
   /// Ticks between a duty write and its effect; the tick predicts that far with the exact
   /// model (0 or 1).
   int pwm_latency_ticks = 1;
@@ -28,9 +27,10 @@ struct DriveConfig {
 
   // The current-fed controller (iol).
   double iol_period_s = 1e-3;  ///< T0, a whole number of sample periods
-  /// Drive the ideal current source (paper 001's current-fed plant; simulation only) instead of
-  /// the inner current loop on the PWM.
-  bool current_source = false;
+  /// Ticks from a current command to the current: 1 for the deadbeat current loop on the PWM
+  /// (it reaches its target one tick after it acts); 0 for a power stage that imposes the
+  /// current at once (the simulation's ideal current source).
+  int current_response_ticks = 1;
   bool outer_speed_loop = false;  ///< v1 from a speed PI (else the torque reference)
   bool outer_flux_loop = false;   ///< v2 from the Fig. 5 loop (else from (21))
   double speed_loop_bandwidth_rad_s = 30.0;

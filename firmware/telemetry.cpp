@@ -72,9 +72,11 @@ void Telemetry::publish(uint64_t k, hal::CanBus& can, const TickRecord<T>& r,
                             float(r.controlled_flux2_Wb2), float(r.controlled_flux2_ref_Wb2)}));
     send(can,
          encode_frame(node_id_, MessageId::telemetry_current,
-                      {float(r.iA_A), float(r.iB_A), float(r.load_est_Nm), float(r.v_bus_V)}));
+                      {float(r.i_s_est_AB_A.x()), float(r.i_s_est_AB_A.y()), float(r.load_est_Nm),
+                       float(r.v_bus_V)}));
     send(can, encode_frame(node_id_, MessageId::telemetry_voltage,
-                           {float(r.u_alpha_V), float(r.u_beta_V), float(sample_count_++)}));
+                           {float(r.u_alphabeta_V.x()), float(r.u_alphabeta_V.y()),
+                            float(sample_count_++)}));
   }
 }
 

@@ -30,9 +30,13 @@ class ControlTimer {
   virtual uint32_t period_ns() const noexcept = 0;
   /// Number of periods since start: the control time base. Tick context.
   virtual uint64_t tick_count() const noexcept = 0;
-  /// A free-running high-resolution clock for measuring execution time (cycle counter on the
-  /// MCU, the monotonic clock on Linux). Tick context.
-  virtual uint64_t execution_clock_ns() const noexcept = 0;
+  /// A free-running counter for timing the tick and its stages: the core's cycles on the MCU,
+  /// nanoseconds of the monotonic clock on Linux. It wraps at 2^32 counts, so only differences
+  /// over less than 2^32 counts mean anything. One cheap read (the drive reads it once per
+  /// stage). Tick context.
+  virtual uint32_t execution_counts() const noexcept = 0;
+  /// The rate of execution_counts(), fixed at configuration.
+  virtual uint32_t execution_clock_Hz() const noexcept = 0;
 };
 
 }  // namespace imd::hal

@@ -53,8 +53,8 @@ class SimBoard {
   hal::CanBus& can() noexcept { return can_; }
   hal::Gpio& gpio() noexcept { return gpio_; }
   hal::ControlTimer& timer() noexcept { return timer_; }
-  hal::AnalogInnerLoop& analog_inner_loop() noexcept { return analog_; }
-  hal::CurrentSource& current_source() noexcept { return current_source_; }
+  SimAnalogInnerLoop& analog_inner_loop() noexcept { return analog_; }
+  SimCurrentSource& current_source() noexcept { return current_source_; }
   SimCan& can_side() noexcept { return can_; }
   const SimPwm& pwm_side() const noexcept { return pwm_; }
 

@@ -20,11 +20,11 @@ bool SimCan::inject(const hal::CanFrame& frame) noexcept {
   return received_.push(frame);
 }
 
-uint64_t SimTimer::execution_clock_ns() const noexcept {
+uint32_t SimTimer::execution_counts() const noexcept {
   const uint64_t host_ns = host_clock_ns();
   uint64_t stall_ns = 0;
   if (in_fire_ && reads_in_fire_++ > 0) stall_ns = stall_ns_;
-  return host_ns + stolen_ns_ + stall_ns;
+  return uint32_t(host_ns + stolen_ns_ + stall_ns);
 }
 
 void SimTimer::fire() noexcept {

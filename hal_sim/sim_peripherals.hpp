@@ -5,11 +5,9 @@
 #include <cstddef>
 #include <cstdint>
 
-#include "hal/analog_inner_loop.hpp"
 #include "hal/can_bus.hpp"
 #include "hal/control_timer.hpp"
 #include "hal/current_adc.hpp"
-#include "hal/current_source.hpp"
 #include "hal/encoder.hpp"
 #include "hal/gpio.hpp"
 #include "hal/pwm.hpp"
@@ -125,8 +123,8 @@ class SimGpio final : public hal::Gpio {
 };
 
 /// Lock-step timer: the board calls the handler once per simulated period. The execution clock
-/// is host_clock_ns() (hal_sim/host_clock.hpp), plus any time a stall (an overrun fault) has
-/// stolen.
+/// counts nanoseconds of host_clock_ns() (hal_sim/host_clock.hpp), plus any time a stall (an
+/// overrun fault) has stolen.
 class SimTimer final : public hal::ControlTimer {
  public:
   explicit SimTimer(uint32_t period_ns) : period_ns_(period_ns) {}
@@ -134,9 +132,11 @@ class SimTimer final : public hal::ControlTimer {
   void stop() noexcept override { handler_ = nullptr; }
   uint32_t period_ns() const noexcept override { return period_ns_; }
   uint64_t tick_count() const noexcept override { return ticks_; }
-  /// Host time plus the stalls of past ticks; inside fire(), every read after the first one
-  /// also adds this tick's stall, so a tick measured from its first read takes stall_ns longer.
-  uint64_t execution_clock_ns() const noexcept override;
+  /// Host time in ns plus the stalls of past ticks, the low 32 bits; inside fire(), every read
+  /// after the first one also adds this tick's stall, so a tick measured from its first read
+  /// takes stall_ns longer.
+  uint32_t execution_counts() const noexcept override;
+  uint32_t execution_clock_Hz() const noexcept override { return 1'000'000'000u; }
   /// Board side: runs the handler (if started) and counts the period.
   void fire() noexcept;
 
@@ -155,15 +155,16 @@ class SimTimer final : public hal::ControlTimer {
   mutable int reads_in_fire_ = 0;
 };
 
-/// The paper's analog inner-feedback device; the board reads the latest input.
-class SimAnalogInnerLoop final : public hal::AnalogInnerLoop {
+/// The analog part of the preliminary feedback (2) of paper 000, a device only the simulated
+/// board has: u(t) = sigma p w(t) J (I(t) + beta Phi(t)) + e^{p th(t) J} v~_k, evaluated
+/// continuously, with v~_k written once per period (rotor-aligned frame). Real boards run (2)
+/// digitally through the PWM; the paper's hybrid scheme needs this device. The board reads the
+/// latest input (in double, so that the paper's exactness can be checked).
+class SimAnalogInnerLoop {
  public:
-  void set_input_AB_V(double v_A_V, double v_B_V) noexcept override {
+  void set_input_AB_V(double v_A_V, double v_B_V) noexcept {
     v_A_V_ = v_A_V;
     v_B_V_ = v_B_V;
-  }
-  void set_input_AB_V(float v_A_V, float v_B_V) noexcept override {
-    set_input_AB_V(double(v_A_V), double(v_B_V));
   }
   double v_A_V() const noexcept { return v_A_V_; }
   double v_B_V() const noexcept { return v_B_V_; }
@@ -172,15 +173,15 @@ class SimAnalogInnerLoop final : public hal::AnalogInnerLoop {
   double v_A_V_ = 0.0, v_B_V_ = 0.0;
 };
 
-/// The ideal current source of paper 001; the board reads the latest current.
-class SimCurrentSource final : public hal::CurrentSource {
+/// An ideal stator current source, as paper 001 assumes ("current-fed"): the rotor-frame
+/// current written is imposed exactly and held until the next write. Real boards reach the
+/// current-fed mode through an inner current loop on the PWM; only the simulated board has
+/// this device. The board reads the latest current (in double).
+class SimCurrentSource {
  public:
-  void set_current_AB_A(double iA_A, double iB_A) noexcept override {
+  void set_current_AB_A(double iA_A, double iB_A) noexcept {
     iA_A_ = iA_A;
     iB_A_ = iB_A;
-  }
-  void set_current_AB_A(float iA_A, float iB_A) noexcept override {
-    set_current_AB_A(double(iA_A), double(iB_A));
   }
   double iA_A() const noexcept { return iA_A_; }
   double iB_A() const noexcept { return iB_A_; }

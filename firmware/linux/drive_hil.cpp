@@ -38,6 +38,7 @@
 #include "hal/linux/queued_can_bus.hpp"
 #include "hal/linux/realtime_timer.hpp"
 #include "hal_sim/config_error.hpp"
+#include "hal_sim/drive/simulated_drive.hpp"
 #include "hal_sim/fault_injection.hpp"
 #include "hal_sim/scenario.hpp"
 #include "hal_sim/sim_board.hpp"
@@ -131,10 +132,10 @@ int run(const Options& o, const imd::sim::Scenario& s, imd::hal::QueuedCanBus* c
   timing.cpu = o.cpu;
   hal::RealtimeTimer timer(timing);
   const firmware::ScenarioReferences<T> references(s);
-  firmware::Drive<T> drive(s.motor, config,
-                           {board.pwm(), board.encoder(), board.adc(), timer,
-                            &board.analog_inner_loop(), &board.current_source(), can, gpio},
-                           references);
+  sim::SimulatedDrive<T> simulated(board, s.motor, config,
+                                   {s.ideal_sensors, s.inner_feedback, s.current_fed},
+                                   &references, timer, can, gpio);
+  firmware::Drive<T>& drive = simulated.drive();
   firmware::HilTick<T> tick(board, drive, s.faults);
 
   std::cerr << fmt::format("drive_hil: {} on {} as node {}, {} Hz, {} precision{}\n", s.source,

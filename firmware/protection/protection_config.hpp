@@ -8,6 +8,10 @@
 namespace imd::firmware {
 
 struct ProtectionConfig {
+  /// The checks on the sensors themselves: off where the drive does not use them (ideal
+  /// sensors in simulation give no encoder counts or ADC codes to judge).
+  bool check_encoder = true;
+  bool check_adc_stuck = true;
   double overcurrent_A = 10.0;     ///< instantaneous, per phase (and any ADC code on a rail)
   double bus_min_V = 20.0;         ///< below: undervoltage while enabled (also a NaN reading)
   double bus_max_V = 450.0;        ///< above: overvoltage, in every state

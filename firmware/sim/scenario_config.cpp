@@ -27,7 +27,8 @@ DriveConfig drive_config(const sim::Scenario& s) {
   c.controller =
       s.controller == "iol" ? ControllerKind::iol : ControllerKind::dsmc;
   c.iol_period_s = s.iol_period_s;
-  c.current_source = s.current_fed;
+  // The ideal current source imposes the current at once; the deadbeat loop a tick later.
+  c.current_response_ticks = s.current_fed ? 0 : 1;
   c.outer_speed_loop = s.outer_speed_loop;
   c.outer_flux_loop = s.outer_flux_loop;
   c.speed_loop_bandwidth_rad_s = s.speed_loop_bandwidth_rad_s;
@@ -35,7 +36,6 @@ DriveConfig drive_config(const sim::Scenario& s) {
   c.flux_loop_time_constant_s = s.flux_loop_time_constant_s;
   c.magnetized_fraction = s.magnetized_fraction;
   c.magnetizing_current_A = s.magnetizing_current_A;
-  c.analog_inner_loop = s.inner_feedback == sim::InnerFeedback::ideal_analog;
   c.pwm_latency_ticks = s.pwm_latency_ticks;
   c.compensate_latency = s.compensate_latency;
   c.i_max_A = s.i_max_A;
@@ -68,6 +68,8 @@ DriveConfig drive_config(const sim::Scenario& s) {
   p.tick_budget_ns = static_cast<uint32_t>(std::lround(set.tick_budget_us.value_or(0.0) * 1e3));
   c.stop_decel_rad_s2 = set.stop_decel_rad_s2.value_or(c.stop_decel_rad_s2);
   c.adc_calibration_ticks = s.ideal_sensors ? 0 : 256;
+  // Ideal sensors give the drive no encoder counts or ADC currents of its own to judge.
+  p.check_encoder = p.check_adc_stuck = !s.ideal_sensors;
   c.adc_offset_limit_A = 0.02 * s.adc.full_scale_A;  // 2 % of full scale (0.2 A on 10 A)
   c.section_iv_load_estimator = s.section_iv;
   c.encoder_observer_bandwidth_rad_s = s.encoder_bandwidth_rad_s;

@@ -18,8 +18,7 @@ TwoStageTick::TwoStageTick(const TwoStageTickConfig& config, SampleStage& sample
       sample_(sample),
       reload_(static_cast<uint32_t>(uint64_t(config.period_ns) * config.core_clock_Hz /
                                     1'000'000'000u) -
-              1u),
-      ns_per_count_q32_((uint64_t(1'000'000'000u) << 32) / config.core_clock_Hz) {}
+              1u) {}
 
 void TwoStageTick::start(hal::TickHandler& handler) noexcept {
   handler_ = &handler;
@@ -41,18 +40,17 @@ void TwoStageTick::resume() noexcept {
   reg32(kSysTickCsr) = kSysTickEnable | kSysTickInterrupt | kSysTickCoreClock;
 }
 
-uint64_t TwoStageTick::execution_clock_ns() const noexcept {
+uint32_t TwoStageTick::execution_counts() const noexcept {
   // The sample stage may preempt between the reads (it adds a period to the base): retry.
-  // Integer arithmetic only, and no division: this runs in the tick.
   for (;;) {
-    const uint64_t base_ns = ns_base_;
+    const uint32_t base = count_base_;
     const uint32_t value = reg32(kSysTickCvr);
-    if (base_ns == ns_base_) return base_ns + ((uint64_t(reload_ - value) * ns_per_count_q32_) >> 32);
+    if (base == count_base_) return base + (reload_ - value);
   }
 }
 
 void TwoStageTick::on_sample_interrupt() noexcept {
-  ns_base_ = ns_base_ + config_.period_ns;
+  count_base_ = count_base_ + (reload_ + 1);
   if (control_busy_) {
     ++overruns_;  // the last control stage has not finished: skip this period
     return;

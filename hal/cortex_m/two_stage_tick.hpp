@@ -8,7 +8,7 @@
 ///
 /// Overrun: if a period ends while the control stage is still pending or running, that period's
 /// sample and control are skipped and counted. The drive also times each tick with
-/// execution_clock_ns() and trips its overrun fault on a tick over its budget.
+/// execution_counts() and trips its overrun fault on a tick over its budget.
 ///
 /// Lock-step: with `lock_step`, the counter stops at the end of each control stage and time
 /// stands still until resume(). The processor-in-the-loop run advances its plant in that pause,
@@ -47,9 +47,10 @@ class TwoStageTick final : public hal::ControlTimer {
   void stop() noexcept override;
   uint32_t period_ns() const noexcept override { return config_.period_ns; }
   uint64_t tick_count() const noexcept override { return ticks_; }
-  /// Counted time since start(): periods passed plus the position in this one, at the
-  /// resolution of one core clock (in lock-step, the pauses are not counted).
-  uint64_t execution_clock_ns() const noexcept override;
+  /// Core clock counts since start(): periods passed plus the position in this one (in
+  /// lock-step, the pauses are not counted). Wraps at 2^32 like a cycle counter.
+  uint32_t execution_counts() const noexcept override;
+  uint32_t execution_clock_Hz() const noexcept override { return config_.core_clock_Hz; }
 
   /// Lock-step: true once the control stage of the last period has finished (time stands
   /// still); resume() clears it and lets the counter run on to the next period.
@@ -71,8 +72,7 @@ class TwoStageTick final : public hal::ControlTimer {
   hal::TickHandler* handler_ = nullptr;
   uint32_t reload_;
   uint64_t ticks_ = 0;
-  uint64_t ns_per_count_q32_;  ///< 1e9 / core_clock_Hz in 32.32 fixed point
-  volatile uint64_t ns_base_ = 0;  ///< the periods passed (written by the sample stage)
+  volatile uint32_t count_base_ = 0;  ///< counts of the periods passed (the sample stage's)
   volatile bool control_busy_ = false;
   std::atomic<bool> paused_{false};
   uint32_t overruns_ = 0;

@@ -73,7 +73,9 @@ class RealtimeTimer final : public ControlTimer {
   uint64_t tick_count() const noexcept override {
     return ticks_.load(std::memory_order_relaxed);
   }
-  uint64_t execution_clock_ns() const noexcept override { return monotonic_ns(); }
+  /// Nanoseconds of the monotonic clock, the low 32 bits.
+  uint32_t execution_counts() const noexcept override { return uint32_t(monotonic_ns()); }
+  uint32_t execution_clock_Hz() const noexcept override { return 1'000'000'000u; }
 
   bool running() const noexcept { return running_.load(); }
   bool realtime() const noexcept { return realtime_; }

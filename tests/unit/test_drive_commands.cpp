@@ -17,14 +17,9 @@ using protocol::CommandKind;
 using protocol::CommandResult;
 using protocol::MessageId;
 
-struct NoProfile final : ReferenceSource<double> {
-  Reference<double> at_tick(uint64_t) const noexcept override { return {}; }
-};
-
 /// The paper-000 motor on a realistic board, commanded over CAN as node 1.
 struct CanRig {
   sim::SimBoard board;
-  NoProfile unused;
   Drive<double> drive;
   protocol::CommandEncoder host{1};
   std::vector<hal::CanFrame> sent;
@@ -49,9 +44,7 @@ struct CanRig {
   explicit CanRig(const DriveConfig& c = config(), hal::Gpio* gpio = nullptr)
       : board(test::test_motors()[0].parameters, board_config()),
         drive(test::test_motors()[0].parameters, c,
-              {board.pwm(), board.encoder(), board.adc(), board.timer(), nullptr, nullptr,
-               &board.can(), gpio},
-              unused) {
+              {board.pwm(), board.encoder(), board.adc(), board.timer(), &board.can(), gpio}) {
     board.timer().start(drive);
   }
   void send(const Command& c) { board.can_side().inject(host.encode(c)); }

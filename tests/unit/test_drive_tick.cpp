@@ -65,7 +65,7 @@ void run_without_allocation() {
   config.speed_reaching_pole = config.flux_reaching_pole = 0.98;
   const Constant<T> references;
   Drive<T> drive(test::test_motors()[0].parameters, config,
-                 {board.pwm(), board.encoder(), board.adc(), board.timer()}, references);
+                 {board.pwm(), board.encoder(), board.adc(), board.timer()}, {&references});
   CountingHandler<T> handler(drive);
   board.timer().start(handler);
   g_allocations = 0;
@@ -90,7 +90,7 @@ TEST(DriveTick, OvercurrentTurnsThePwmOffInTheSameTick) {
   config.protection.overcurrent_A = 9.0;
   const Constant<double> references;
   Drive<double> drive(test::test_motors()[0].parameters, config,
-                      {board.pwm(), board.encoder(), board.adc(), board.timer()}, references);
+                      {board.pwm(), board.encoder(), board.adc(), board.timer()}, {&references});
   board.timer().start(drive);
   for (int k = 0; k < 3000; ++k) board.run_tick();
   ASSERT_TRUE(board.pwm().enabled());
@@ -114,7 +114,7 @@ struct Rig {
   Rig(const sim::SimBoardConfig& board_config, const DriveConfig& config)
       : board(test::test_motors()[0].parameters, board_config),
         drive(test::test_motors()[0].parameters, config,
-              {board.pwm(), board.encoder(), board.adc(), board.timer()}, references) {
+              {board.pwm(), board.encoder(), board.adc(), board.timer()}, {&references}) {
     board.timer().start(drive);
   }
 };

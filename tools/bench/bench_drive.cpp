@@ -54,7 +54,7 @@ void BM_TickOnly(benchmark::State& bench) {
   config.i_max_A = 6.0;
   config.speed_reaching_pole = config.flux_reaching_pole = 0.98;
   imd::firmware::Drive<T> drive(
-      s.motor, config, {board.pwm(), board.encoder(), board.adc(), board.timer()}, references);
+      s.motor, config, {board.pwm(), board.encoder(), board.adc(), board.timer()}, {&references});
   board.timer().start(drive);
   for (int k = 0; k < 5000 && drive.state() != imd::firmware::DriveState::running; ++k)
     board.run_tick();

@@ -10,6 +10,7 @@
 #include "firmware/drive.hpp"
 #include "firmware/sim/run_metrics.hpp"
 #include "firmware/sim/scenario_config.hpp"
+#include "hal_sim/drive/simulated_drive.hpp"
 #include "hal_sim/sim_board.hpp"
 #include "hal_sim/sim_can_host.hpp"
 #include "tools/drive_sim/scripted_commands.hpp"
@@ -17,36 +18,15 @@
 namespace imd::sim {
 namespace {
 
-/// The plant's state in the rotor frame: the "ideal sensors" of paper 000, Section III.
-/// T: the drive's arithmetic; the plant's double state is rounded to it.
-template <typename T>
-class PlantOracle final : public firmware::StateOracle<T> {
- public:
-  explicit PlantOracle(const SimBoard& board) : board_(board) {}
-  firmware::TrueState<T> true_state() const noexcept override {
-    const PlantState& s = board_.plant().state();
-    const auto rotor =
-        control::Rotation<double>::from_angle(board_.plant().pole_pairs() * s.theta_mech_rad);
-    const Vec2 flux = rotor.apply_inverse(s.flux_r_alphabeta_Wb);
-    const Vec2 current = rotor.apply_inverse(s.i_s_alphabeta_A);
-    return {T(flux.x()),           T(flux.y()),         T(current.x()),       T(current.y()),
-            T(s.omega_mech_rad_s), T(s.theta_mech_rad), T(board_.load_Nm())};
-  }
-
- private:
-  const SimBoard& board_;
-};
-
 template <typename T>
 Summary run(const Scenario& s, const RunCallbacks& callbacks) {
   SimBoard board(s.motor, firmware::board_config(s));
   firmware::prepare_board(board, s);
   const firmware::ScenarioReferences<T> references(s);
-  const PlantOracle<T> oracle(board);
-  firmware::Drive<T> drive(s.motor, firmware::drive_config(s),
-                           {board.pwm(), board.encoder(), board.adc(), board.timer(),
-                            &board.analog_inner_loop(), &board.current_source(), &board.can()},
-                           references, s.ideal_sensors ? &oracle : nullptr);
+  SimulatedDrive<T> simulated(board, s.motor, firmware::drive_config(s),
+                              {s.ideal_sensors, s.inner_feedback, s.current_fed}, &references,
+                              board.timer(), &board.can());
+  firmware::Drive<T>& drive = simulated.drive();
   const std::vector<ScriptedFrame> commands = scripted_frames(s);
   std::size_t next_command = 0, next_fault = 0;
   std::vector<std::size_t> unanswered;        // injected faults not yet detected (indices)
@@ -117,16 +97,16 @@ Summary run(const Scenario& s, const RunCallbacks& callbacks) {
     row.flux2_Wb2 = flux_AB.squaredNorm();
     row.flux2_ref_Wb2 = s.flux2_Wb2;
     row.flux2_est_Wb2 = rec.flux2_est_Wb2;
-    row.flux_A_est_Wb = rec.flux_est_A_Wb;
-    row.flux_B_est_Wb = rec.flux_est_B_Wb;
+    row.flux_A_est_Wb = rec.flux_est_AB_Wb.x();
+    row.flux_B_est_Wb = rec.flux_est_AB_Wb.y();
     row.load_Nm = load_Nm;
     row.load_est_Nm = rec.load_est_Nm;
     row.i_alpha_A = truth.i_s_alphabeta_A.x();
     row.i_beta_A = truth.i_s_alphabeta_A.y();
     row.v_alpha_V = board.applied_voltage_V().x();
     row.v_beta_V = board.applied_voltage_V().y();
-    row.discriminant = rec.discriminant;
-    row.c_k = rec.c_k;
+    row.discriminant = rec.law.discriminant;
+    row.c_k = rec.law.c_k;
     row.theta_mech_rad = truth.theta_mech_rad;
     row.theta_est_rad = rec.theta_est_rad;
     row.torque_Nm = board.start_torque_Nm();
@@ -134,8 +114,8 @@ Summary run(const Scenario& s, const RunCallbacks& callbacks) {
       const Vec2 flux_s_AB = rotor.apply_inverse(board.start_flux_s_alphabeta_Wb());
       row.stator_flux2_Wb2 = flux_s_AB.squaredNorm();
       row.stator_flux2_ref_Wb2 = s.stator_flux2_Wb2;
-      row.iol_boundary = rec.iol_boundary;
-      if (rec.iol_boundary) {
+      row.iol_boundary = rec.law.iol_boundary;
+      if (rec.law.iol_boundary) {
         // y2 of (20) from the true stator fluxes of this and the last boundary.
         held.y2 = flux_s_AB.dot(boundary_flux_s) - flux_decay * boundary_flux_s.squaredNorm();
         boundary_flux_s = flux_s_AB;
@@ -143,16 +123,16 @@ Summary run(const Scenario& s, const RunCallbacks& callbacks) {
           torque_sq += (row.torque_Nm - pending_torque_cmd) * (row.torque_Nm - pending_torque_cmd);
           ++torque_count;
         }
-        pending_torque_cmd = rec.torque_cmd_Nm;
-        held.torque_ref_Nm = rec.torque_ref_Nm;
-        held.y2_ref = rec.y2_ref;
+        pending_torque_cmd = rec.law.torque_cmd_Nm;
+        held.torque_ref_Nm = rec.law.torque_ref_Nm;
+        held.y2_ref = rec.law.y2_ref;
       }
       // How far the stator current departs from the rotor-frame zero-order hold paper 001
       // assumes: the current at the start of the period (after any step) against the current
       // the law takes as held over it.
       const Vec2 i_AB = rotor.apply_inverse(board.start_current_alphabeta_A());
       row.i_hold_err_A = iol && rec.state == firmware::DriveState::running
-                             ? (i_AB - Vec2(rec.iA_held_A, rec.iB_held_A)).norm()
+                             ? (i_AB - rec.law.i_held_AB_A.template cast<double>()).norm()
                              : 0.0;
       if (iol && t_s > s.settle_s) {
         hold_sq += row.i_hold_err_A * row.i_hold_err_A;
@@ -166,12 +146,12 @@ Summary run(const Scenario& s, const RunCallbacks& callbacks) {
     row.omega_ref_cmd_rad_s = rec.omega_ref_rad_s;
     row.flux2_ctrl_est_Wb2 = rec.controlled_flux2_Wb2;
     row.flux2_ctrl_ref_Wb2 = rec.controlled_flux2_ref_Wb2;
-    row.iA_est_A = rec.iA_A;
-    row.iB_est_A = rec.iB_A;
+    row.iA_est_A = rec.i_s_est_AB_A.x();
+    row.iB_est_A = rec.i_s_est_AB_A.y();
     row.v_bus_meas_V = rec.v_bus_V;
-    row.u_alpha_cmd_V = rec.u_alpha_V;
-    row.u_beta_cmd_V = rec.u_beta_V;
-    row.saturated = rec.speed_saturated || rec.flux_saturated || rec.voltage_clipped;
+    row.u_alpha_cmd_V = rec.u_alphabeta_V.x();
+    row.u_beta_cmd_V = rec.u_alphabeta_V.y();
+    row.saturated = rec.law.speed_saturated || rec.law.flux_saturated || rec.voltage_clipped;
 
     const double current_A = truth.i_s_alphabeta_A.norm();
     if (summary.running_from_s < 0 && rec.state == firmware::DriveState::running)

@@ -24,7 +24,7 @@ using imd::firmware::ControllerKind;
 using imd::firmware::DriveConfig;
 
 // A new field must be written here too: these sizes fail the build until it is.
-static_assert(sizeof(DriveConfig) == 368, "DriveConfig changed: write its new fields below");
+static_assert(sizeof(DriveConfig) == 376, "DriveConfig changed: write its new fields below");
 static_assert(sizeof(imd::sim::SimBoardConfig) == 112, "SimBoardConfig changed: write it below");
 static_assert(sizeof(imd::control::MotorParameters) == 64, "MotorParameters changed");
 
@@ -117,11 +117,10 @@ void write_drive(Writer& w, const DriveConfig& c) {
   w.number("drive.sample_period_s", c.sample_period_s);
   w.line("drive.controller", c.controller == ControllerKind::iol ? "ControllerKind::iol"
                                                                  : "ControllerKind::dsmc");
-  w.boolean("drive.analog_inner_loop", c.analog_inner_loop);
   w.integer("drive.pwm_latency_ticks", c.pwm_latency_ticks);
   w.boolean("drive.compensate_latency", c.compensate_latency);
   w.number("drive.iol_period_s", c.iol_period_s);
-  w.boolean("drive.current_source", c.current_source);
+  w.integer("drive.current_response_ticks", c.current_response_ticks);
   w.boolean("drive.outer_speed_loop", c.outer_speed_loop);
   w.boolean("drive.outer_flux_loop", c.outer_flux_loop);
   w.number("drive.speed_loop_bandwidth_rad_s", c.speed_loop_bandwidth_rad_s);
@@ -144,6 +143,8 @@ void write_drive(Writer& w, const DriveConfig& c) {
   w.number("drive.load_estimator_pole", c.load_estimator_pole);
   w.number("drive.min_flux2_Wb2", c.min_flux2_Wb2);
   const imd::firmware::ProtectionConfig& p = c.protection;
+  w.boolean("drive.protection.check_encoder", p.check_encoder);
+  w.boolean("drive.protection.check_adc_stuck", p.check_adc_stuck);
   w.number("drive.protection.overcurrent_A", p.overcurrent_A);
   w.number("drive.protection.bus_min_V", p.bus_min_V);
   w.number("drive.protection.bus_max_V", p.bus_max_V);

@@ -20,6 +20,7 @@
 #include "hal/cortex_m/fault_handler.hpp"
 #include "hal/cortex_m/semihosting.hpp"
 #include "hal/cortex_m/two_stage_tick.hpp"
+#include "hal_sim/drive/simulated_drive.hpp"
 #include "hal_sim/sim_board.hpp"
 
 namespace imd::firmware {
@@ -63,16 +64,17 @@ int run(const EmbeddedScenario& s, cm::CmsdkUart& console) {
   static SimulatedSensors sensors(board);
   static cm::TwoStageTick timer(
       {mps2::kCoreClock_Hz, static_cast<uint32_t>(s.board.period_s * 1e9 + 0.5), true}, sensors);
-  static Drive<float> drive(s.motor, s.drive,
-                            {board.pwm(), board.encoder(), board.adc(), timer, nullptr, nullptr,
-                             &board.can(), nullptr},
-                            references);
+  // The realistic board: the drive's own sensing, estimation and SVPWM, no substitutes.
+  static sim::SimulatedDrive<float> simulated(board, s.motor, s.drive, {}, &references, timer,
+                                              &board.can());
+  Drive<float>& drive = simulated.drive();
   RunMetrics metrics(s.settle_s);
   PilReport report(console);
   report.start(s, timer.counts_per_period());  // with the stack used so far: the start-up's
 
   const auto ticks = static_cast<uint64_t>(s.duration_s / s.board.period_s + 0.5);
   uint64_t frames_sent = 0;
+  StageTotals stage_totals;
   double running_from_s = -1.0;
   hal::CanFrame frame;
   references.fill_from(0);
@@ -89,12 +91,14 @@ int run(const EmbeddedScenario& s, cm::CmsdkUart& console) {
     const TickRecord<float>& rec = drive.record();
     while (board.can_side().take_sent(frame)) ++frames_sent;  // the host side reads the bus
     if (running_from_s < 0 && rec.state == DriveState::running) running_from_s = t_s;
+    stage_totals.add(rec.stage_counts);
     metrics.add(tracking_sample(s, truth, load_Nm, rec, t_s));
     board.end_period();
     references.fill_from(k + 1);
     if (!truth.i_s_alphabeta_A.allFinite()) break;
   }
   timer.stop();
+  report.stages(stage_totals, timer.execution_clock_Hz());
   return report.finish(drive, timer, metrics, running_from_s, frames_sent);
 }
 

@@ -19,11 +19,23 @@ namespace imd::firmware {
 MetricsSample tracking_sample(const EmbeddedScenario& s, const sim::PlantState& truth,
                               double load_Nm, const TickRecord<float>& record, double t_s) noexcept;
 
+/// Stage durations summed over the run, in execution-clock counts (firmware/stages/stage_clock.hpp).
+struct StageTotals {
+  uint64_t counts[kStageCount] = {};
+  uint64_t ticks = 0;
+  void add(const StageCounts& c) noexcept {
+    for (int i = 0; i < kStageCount; ++i) counts[i] += c[i];
+    ++ticks;
+  }
+};
+
 class PilReport {
  public:
   explicit PilReport(hal::cortex_m::CmsdkUart& console) noexcept : console_(console) {}
 
   void start(const EmbeddedScenario& s, uint32_t counts_per_period) noexcept;
+  /// Prints each stage's mean counts per tick.
+  void stages(const StageTotals& totals, uint32_t clock_Hz) noexcept;
   /// Prints the summary; returns the exit status (0: no fault, no overrun, metrics measured).
   int finish(const Drive<float>& drive, const hal::cortex_m::TwoStageTick& timer,
              const RunMetrics& metrics, double running_from_s, uint64_t frames_sent) noexcept;

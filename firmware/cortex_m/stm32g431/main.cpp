@@ -11,7 +11,6 @@
 /// g_fatal_fault / g_boot_failure for a debugger.
 #include <cstdint>
 
-#include "firmware/commanded_reference.hpp"
 #include "firmware/cortex_m/stm32g431/board_config.hpp"
 #include "firmware/drive.hpp"
 #include "hal/cortex_m/armv7m.hpp"
@@ -78,12 +77,9 @@ int main() {
   if (!can.ok()) halt(BootFailure::can);
   static g4::AdcEncoderSample sample(adc, encoder);
   static g4::AdcTick tick(kTick, adc, sample);
-  // With commands_over_can the drive follows its own CAN-commanded references; this source is
-  // required by the constructor but not read.
-  static const firmware::CommandedReference<float> unused_references(0.0f, 0.0f);
+  // The drive follows its own CAN-commanded references (commands_over_can).
   static firmware::Drive<float> drive(kMotor, drive_config(),
-                                      {pwm, encoder, adc, tick, nullptr, nullptr, &can, &gpio},
-                                      unused_references);
+                                      {pwm, encoder, adc, tick, &can, &gpio});
 
   // The carrier (and with it the ADC trigger) starts; the update event must be the peak.
   if (!pwm.start()) halt(BootFailure::pwm_phase);

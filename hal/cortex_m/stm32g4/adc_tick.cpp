@@ -13,12 +13,6 @@ AdcTick* g_adc_tick = nullptr;
 
 constexpr uint32_t kSequenceSkewLimit_cycles = 340;  // 2 us at 170 MHz
 
-/// The 32-bit counter extended by the last extension point `base` (the counter has advanced by
-/// less than 2^32 since).
-uint64_t extend(uint64_t base, uint32_t now) noexcept {
-  return base + static_cast<uint32_t>(now - static_cast<uint32_t>(base));
-}
-
 }  // namespace
 
 void bind_adc_tick_interrupts(AdcTick& timer) noexcept {
@@ -28,16 +22,13 @@ void bind_adc_tick_interrupts(AdcTick& timer) noexcept {
 AdcTick::AdcTick(const AdcTickConfig& config, AdcInjected& adc, SampleStage& sample) noexcept
     : config_(config),
       adc_(adc),
-      sample_(sample),
-      ns_per_cycle_q32_((uint64_t(1'000'000'000u) << 32) / config.core_clock_Hz) {}
+      sample_(sample) {}
 
 void AdcTick::start(hal::TickHandler& handler) noexcept {
   handler_ = &handler;
   // ADC1_2 highest, PendSV lowest (SHPR3 [23:16]): the sample preempts a late control stage.
   reg32(kScbShpr3) = (reg32(kScbShpr3) & ~(0xFFu << 16)) | (0xFFu << 16);
   nvic_set_priority(kIrqAdc1_2, kPriorityHighest);
-  cycles_ = cycle_count();
-  start_cycles_ = cycles_;
   adc_.acknowledge();  // a sequence that ended before start() is not a tick
   adc_.set_interrupt(true);
   nvic_enable(kIrqAdc1_2);
@@ -49,18 +40,8 @@ void AdcTick::stop() noexcept {
   handler_ = nullptr;
 }
 
-uint64_t AdcTick::execution_clock_ns() const noexcept {
-  // The sample stage may preempt between the reads (it moves the extension point): retry.
-  for (;;) {
-    const uint64_t base = cycles_;
-    const uint32_t now = cycle_count();
-    if (base != cycles_) continue;
-    const uint64_t c = extend(base, now) - start_cycles_;
-    // c * q / 2^32 with q = qi 2^32 + qf, without overflow: hi q + lo qi + (lo qf) >> 32.
-    const uint64_t hi = c >> 32, lo = c & 0xFFFF'FFFFu;
-    const uint64_t qi = ns_per_cycle_q32_ >> 32, qf = ns_per_cycle_q32_ & 0xFFFF'FFFFu;
-    return hi * ns_per_cycle_q32_ + lo * qi + ((lo * qf) >> 32);
-  }
+uint32_t AdcTick::execution_counts() const noexcept {
+  return cycle_count();
 }
 
 void AdcTick::on_sample_interrupt() noexcept {
@@ -80,7 +61,6 @@ void AdcTick::on_sample_interrupt() noexcept {
     ended = adc_.ended_sequences();
   }
   adc_.acknowledge();
-  cycles_ = extend(cycles_, cycle_count());
   if (control_busy_) {
     ++overruns_;  // the last control stage has not finished: skip this period
     return;

@@ -10,10 +10,8 @@
 ///
 /// Overrun: if a sample arrives while the control stage is still pending or running, that
 /// period's sample and control are skipped and counted (as in TwoStageTick). The drive also
-/// times each tick with execution_clock_ns() and trips its overrun fault over its budget.
-///
-/// execution_clock_ns(): the DWT cycle counter (32 bits, 25 s at 170 MHz) extended to 64 bits
-/// at every sample; counted from start(). After stop() it stays valid for 25 s.
+/// times each tick and its stages with execution_counts(), the DWT cycle counter (32 bits,
+/// wrapping every 25 s at 170 MHz), and trips its overrun fault over its budget.
 #include <cstdint>
 
 #include "hal/control_timer.hpp"
@@ -53,8 +51,9 @@ class AdcTick final : public hal::ControlTimer {
   void stop() noexcept override;
   uint32_t period_ns() const noexcept override { return config_.period_ns; }
   uint64_t tick_count() const noexcept override { return ticks_; }
-  /// Core clock cycles since start(), in ns (no division: a 32.32 multiply). Tick context.
-  uint64_t execution_clock_ns() const noexcept override;
+  /// The DWT cycle counter: one register read. Tick context.
+  uint32_t execution_counts() const noexcept override;
+  uint32_t execution_clock_Hz() const noexcept override { return config_.core_clock_Hz; }
 
   /// Periods whose sample and control were skipped because the last control stage was late.
   uint32_t overruns() const noexcept { return overruns_; }
@@ -71,9 +70,6 @@ class AdcTick final : public hal::ControlTimer {
   SampleStage& sample_;
   hal::TickHandler* handler_ = nullptr;
   uint64_t ticks_ = 0;
-  uint64_t ns_per_cycle_q32_;     ///< 1e9 / core_clock_Hz in 32.32 fixed point
-  volatile uint64_t cycles_ = 0;  ///< the cycle counter, extended (written by the sample stage)
-  uint64_t start_cycles_ = 0;
   volatile bool control_busy_ = false;
   uint32_t overruns_ = 0;
   uint32_t sample_faults_ = 0;

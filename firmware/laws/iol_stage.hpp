@@ -44,7 +44,7 @@ class IolStage {
                                            config.torque_limit_Nm, config.iol_period_s)),
         ticks_per_period_(
             static_cast<int>(std::lround(config.iol_period_s / config.sample_period_s))),
-        lead_ticks_((config.current_source ? 0 : 1) + config.pwm_latency_ticks),
+        lead_ticks_(config.current_response_ticks + config.pwm_latency_ticks),
         outer_speed_loop_(config.outer_speed_loop),
         outer_flux_loop_(config.outer_flux_loop),
         sigma_H_(T(motor.Ls_H - motor.Lm_H * motor.Lm_H / motor.Lr_H)),

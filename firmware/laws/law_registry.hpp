@@ -1,0 +1,58 @@
+#pragma once
+/// The drive's control laws, all built at start-up (a law is chosen at run time, over CAN, while
+/// the drive is idle). This is the one place where laws are registered: a new law is one entry
+/// in `Laws` below, in ControllerKind order (firmware/drive_config.hpp; its name comes from the
+/// CAN protocol's value table, firmware/protocol/messages.hpp). docs/architecture.md, "How to
+/// add a control law".
+#include <array>
+#include <tuple>
+#include <utility>
+
+#include "firmware/drive_config.hpp"
+#include "firmware/laws/control_law.hpp"
+#include "firmware/laws/dsmc_law.hpp"
+#include "firmware/laws/iol_law.hpp"
+#include "firmware/laws/law_context.hpp"
+
+namespace imd::firmware {
+
+template <typename T>
+using Laws = std::tuple<DsmcLaw<T>, IolLaw<T>>;
+
+template <typename T>
+class LawRegistry {
+ public:
+  static constexpr std::size_t kCount = std::tuple_size_v<Laws<T>>;
+  static_assert(kCount == kControllerCount, "one law per ControllerKind");
+
+  explicit LawRegistry(const LawContext& c)
+      : laws_(make(c, std::make_index_sequence<kCount>{})),
+        table_(std::apply([](auto&... law) { return Table{&law...}; }, laws_)) {
+    check_order(std::make_index_sequence<kCount>{});
+  }
+  LawRegistry(const LawRegistry&) = delete;
+  LawRegistry& operator=(const LawRegistry&) = delete;
+
+  ControlLaw<T>& law(ControllerKind kind) noexcept { return *table_[static_cast<int>(kind)]; }
+  const ControlLaw<T>& law(ControllerKind kind) const noexcept {
+    return *table_[static_cast<int>(kind)];
+  }
+
+ private:
+  using Table = std::array<ControlLaw<T>*, kCount>;
+
+  template <std::size_t... I>
+  static Laws<T> make(const LawContext& c, std::index_sequence<I...>) {
+    return Laws<T>(std::tuple_element_t<I, Laws<T>>(c)...);
+  }
+  template <std::size_t... I>
+  static constexpr void check_order(std::index_sequence<I...>) {
+    static_assert(((static_cast<std::size_t>(std::tuple_element_t<I, Laws<T>>::kKind) == I) && ...),
+                  "Laws lists the laws in ControllerKind order");
+  }
+
+  Laws<T> laws_;
+  Table table_;
+};
+
+}  // namespace imd::firmware

@@ -1,0 +1,134 @@
+#include "firmware/protection/protection.hpp"
+
+#include <cmath>
+
+#include "firmware/duration_ticks.hpp"
+
+namespace imd::firmware {
+namespace {
+
+template <typename T>
+bool finite(const control::Vec2<T>& v) noexcept {
+  return std::isfinite(v.x()) && std::isfinite(v.y());
+}
+
+}  // namespace
+
+template <typename T>
+Protection<T>::Protection(const control::MotorParameters& motor, const DriveConfig& config,
+                          double counts_per_rev, double adc_A_per_code) noexcept
+    : config_(config.protection),
+      commands_over_can_(config.commands_over_can),
+      overcurrent_A_(T(config.protection.overcurrent_A)),
+      bus_min_V_(T(config.protection.bus_min_V)),
+      bus_max_V_(T(config.protection.bus_max_V)),
+      overspeed_rad_s_(T(config.protection.overspeed_rad_s)),
+      pole_pairs_(T(motor.pole_pairs)),
+      torque_per_AWb_(
+          T(control::kClarkeTorqueFactor * motor.pole_pairs * motor.Lm_H / motor.Lr_H)),
+      magnetizing_timeout_ticks_(
+          duration_ticks(config.magnetizing_timeout_s, config.sample_period_s)),
+      command_timeout_ticks_(
+          duration_ticks(config.protection.command_timeout_s, config.sample_period_s)),
+      encoder_check_({counts_per_rev, config.sample_period_s, motor.J_kgm2, motor.friction_Nms,
+                      config.protection.encoder_missing_counts,
+                      config.protection.encoder_window_s, config.protection.overspeed_rad_s}),
+      adc_stuck_check_(config.protection.adc_stuck_ticks, config.sample_period_s,
+                       control::derive_voltage_fed(motor).sigma_H, adc_A_per_code),
+      phase_loss_check_(config.protection.phase_loss_ratio,
+                        config.protection.phase_loss_min_current_A,
+                        static_cast<uint32_t>(duration_ticks(
+                            config.protection.phase_loss_max_window_s, config.sample_period_s))) {}
+
+template <typename T>
+void Protection<T>::set_clock(uint32_t clock_Hz) noexcept {
+  const double counts = double(config_.tick_budget_ns) * 1e-9 * double(clock_Hz);
+  budget_counts_ = counts < 4e9 ? static_cast<uint32_t>(std::llround(counts)) : UINT32_MAX;
+}
+
+template <typename T>
+Trip Protection<T>::check(const Measurement<T>& m, const Estimate<T>& e, const SupervisedState& s,
+                          const LawOutput<T>& law, const Modulation<T>& out,
+                          const control::Vec2<T>& u_last_V) noexcept {
+  Trip trip;
+  if (s.restarted) {
+    encoder_check_.reset();
+    adc_stuck_check_.reset();
+    phase_loss_check_.reset();
+  }
+  if (!s.enable_input && s.modulating) trip.add(FaultCode::enable_input);
+  if (m.calibration == Calibration::offset_fault) {
+    trip.add(FaultCode::adc_offset, m.offset_fault_phase);
+  }
+  if (!m.valid) return trip;  // nothing measured: calibrating, or offsets unknown
+  check_sensed(m, e, s.modulating, trip);
+  if (!s.modulating || trip.any()) {
+    adc_stuck_check_.reset();
+    phase_loss_check_.reset();
+    return trip;
+  }
+  check_driving(m, e, s, u_last_V, trip);
+  if (trip.any()) return trip;
+  if (s.magnetizing && s.magnetizing_ticks > magnetizing_timeout_ticks_) {
+    trip.add(FaultCode::magnetizing_timeout);
+    return trip;
+  }
+  if (!law.ok) trip.add(FaultCode::singular_control);
+  if (!out.finite) trip.add(FaultCode::non_finite);
+  return trip;
+}
+
+template <typename T>
+void Protection<T>::check_sensed(const Measurement<T>& m, const Estimate<T>& e, bool modulating,
+                                 Trip& trip) noexcept {
+  if (m.i_peak_A > overcurrent_A_ || m.adc_saturated) {
+    int phase = 0;
+    for (int i = 1; i < 3; ++i) {
+      if (std::abs(m.i_abc_A[i]) > std::abs(m.i_abc_A[phase])) phase = i;
+    }
+    trip.add(FaultCode::overcurrent, uint8_t(phase));
+  }
+  if (m.v_bus_V > bus_max_V_) trip.add(FaultCode::bus_overvoltage);
+  if (std::abs(e.x.omega_mech_rad_s) > overspeed_rad_s_) trip.add(FaultCode::overspeed);
+  if (!finite(e.x.flux_r_AB_Wb) || !finite(e.x.i_s_AB_A) || !std::isfinite(e.x.omega_mech_rad_s) ||
+      !std::isfinite(e.load_Nm)) {
+    trip.add(FaultCode::non_finite);
+  }
+  const bool driving = modulating && !trip.any();  // a fault has turned the PWM off
+  const T torque_Nm =
+      driving ? torque_per_AWb_ * control::dot_J<T>(e.x.i_s_AB_A, e.x.flux_r_AB_Wb) : T(0);
+  if (config_.check_encoder && encoder_check_.failed(m.encoder_delta_counts, e.x.omega_mech_rad_s,
+                                                     e.load_Nm, torque_Nm, driving)) {
+    trip.add(FaultCode::encoder);
+  }
+}
+
+template <typename T>
+void Protection<T>::check_driving(const Measurement<T>& m, const Estimate<T>& e,
+                                  const SupervisedState& s, const control::Vec2<T>& u_last_V,
+                                  Trip& trip) noexcept {
+  if (!(m.v_bus_V >= bus_min_V_)) trip.add(FaultCode::bus_undervoltage);  // NaN too
+  if (config_.check_adc_stuck && adc_stuck_check_.stuck(m.phase_code, u_last_V)) {
+    trip.add(FaultCode::adc_stuck);
+  }
+  const T flux_angle_rad =
+      pole_pairs_ * e.x.theta_mech_rad + std::atan2(e.x.flux_r_AB_Wb.y(), e.x.flux_r_AB_Wb.x());
+  const int lost = phase_loss_check_.lost_phase(m.i_abc_A, flux_angle_rad);
+  if (lost >= 0) trip.add(FaultCode::phase_loss, uint8_t(lost));
+  if (commands_over_can_ && command_timeout_ticks_ > 0 && s.watchdog_armed &&
+      s.command_silence_ticks > command_timeout_ticks_) {
+    trip.add(FaultCode::command_timeout);
+  }
+}
+
+template <typename T>
+Trip Protection<T>::over_budget(uint32_t exec_counts) const noexcept {
+  Trip trip;
+  if (budget_counts_ > 0 && exec_counts > budget_counts_) trip.add(FaultCode::overrun);
+  return trip;
+}
+
+template class Protection<float>;
+template class Protection<double>;
+
+}  // namespace imd::firmware

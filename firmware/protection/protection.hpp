@@ -1,0 +1,73 @@
+#pragma once
+/// The protect stage: every trip decision of the tick, in one place, before the PWM write. It
+/// returns the faults found (Trip); the supervisor latches them and the PWM goes off in the same
+/// tick. The checks, in the order in which the first fault is named (docs/safety.md):
+///   1. the board's enable input lost while the inverter drives the motor;
+///   2. while calibrating: an ADC offset beyond its limit;
+///   3. in every state: over-current (or an ADC code on a rail), bus over-voltage, over-speed,
+///      a non-finite estimate, the encoder;
+///   4. while the inverter drives the motor (and nothing above tripped): bus under-voltage, a
+///      stuck ADC, a lost phase, the command watchdog;
+///   5. then (nothing above tripped): the magnetizing timeout, a law without solution, a
+///      non-finite output.
+/// The tick's execution time is judged at its end (over_budget). Tick context except
+/// construction.
+#include <cstdint>
+
+#include "control/motor_parameters.hpp"
+#include "firmware/drive_config.hpp"
+#include "firmware/laws/control_law.hpp"
+#include "firmware/protection/adc_stuck_check.hpp"
+#include "firmware/protection/encoder_check.hpp"
+#include "firmware/protection/phase_loss_check.hpp"
+#include "firmware/protection/trip.hpp"
+#include "firmware/stages/estimate.hpp"
+#include "firmware/stages/measurement.hpp"
+#include "firmware/stages/power_stage.hpp"
+
+namespace imd::firmware {
+
+/// What the supervisor knows that the checks need (TickPlan carries it).
+struct SupervisedState {
+  bool modulating = false;    ///< magnetizing, running or stopping: the inverter drives
+  bool enable_input = true;   ///< the board's enable input (true without one)
+  bool restarted = false;     ///< enabled or cleared this tick: the checks start afresh
+  uint64_t magnetizing_ticks = 0;  ///< ticks since magnetizing began (while magnetizing)
+  bool magnetizing = false;
+  bool watchdog_armed = false;     ///< CAN-commanded and magnetizing or running
+  uint64_t command_silence_ticks = 0;  ///< since the last valid command
+};
+
+template <typename T>
+class Protection {
+ public:
+  /// `counts_per_rev`, `adc_A_per_code`: the board's encoder and ADC.
+  Protection(const control::MotorParameters& motor, const DriveConfig& config,
+             double counts_per_rev, double adc_A_per_code) noexcept;
+
+  Trip check(const Measurement<T>& m, const Estimate<T>& e, const SupervisedState& s,
+             const LawOutput<T>& law, const Modulation<T>& out,
+             const control::Vec2<T>& u_last_V) noexcept;
+  /// The tick took `exec_counts` of the execution clock: an overrun past the budget.
+  Trip over_budget(uint32_t exec_counts) const noexcept;
+  /// The budget in execution-clock counts (0: not checked), for a clock of `clock_Hz`.
+  void set_clock(uint32_t clock_Hz) noexcept;
+
+ private:
+  void check_sensed(const Measurement<T>& m, const Estimate<T>& e, bool modulating,
+                    Trip& trip) noexcept;
+  void check_driving(const Measurement<T>& m, const Estimate<T>& e, const SupervisedState& s,
+                     const control::Vec2<T>& u_last_V, Trip& trip) noexcept;
+
+  ProtectionConfig config_;
+  bool commands_over_can_;
+  T overcurrent_A_, bus_min_V_, bus_max_V_, overspeed_rad_s_;
+  T pole_pairs_, torque_per_AWb_;
+  uint64_t magnetizing_timeout_ticks_, command_timeout_ticks_;
+  uint32_t budget_counts_ = 0;
+  EncoderCheck<T> encoder_check_;
+  AdcStuckCheck<T> adc_stuck_check_;
+  PhaseLossCheck<T> phase_loss_check_;
+};
+
+}  // namespace imd::firmware

@@ -1,0 +1,42 @@
+#pragma once
+/// The modulate stage's interface: what turns the law's command into what acts on the motor.
+/// On a board that is the inner feedback (2) run digitally, the voltage limit and SVPWM on the
+/// PWM (SvpwmStage); a simulation may substitute the paper's analog inner-loop circuit or an
+/// ideal current source (hal_sim/drive/) through the same interface. modulate() computes, and
+/// write() applies once protection has passed; the PWM's enable gates every power stage.
+/// Tick context.
+#include "control/frames.hpp"
+#include "control/voltage_fed_model.hpp"
+#include "firmware/laws/control_law.hpp"
+#include "hal/pwm.hpp"
+
+namespace imd::firmware {
+
+template <typename T>
+struct Modulation {
+  /// The rotor-frame input v~ that will really act (after the voltage limit), for the
+  /// observers and the prediction.
+  control::Vec2<T> v_acting_AB_V = control::Vec2<T>::Zero();
+  control::Vec2<T> u_alphabeta_V = control::Vec2<T>::Zero();  ///< stator voltage command
+  hal::PhaseDuties duty{0.5f, 0.5f, 0.5f};
+  bool clipped = false;  ///< the request exceeded the linear range and was scaled down
+  bool finite = true;    ///< false: a NaN or Inf on the way to the power stage
+};
+
+template <typename T>
+class PowerStage {
+ protected:
+  // Never deleted through the interface (nothing is allocated): no virtual destructor, so
+  // no deleting destructor and no operator delete in the vtables of the firmware.
+  ~PowerStage() = default;
+
+ public:
+  /// What the law's output becomes over the period that starts in state `x_input`.
+  virtual Modulation<T> modulate(const LawOutput<T>& law,
+                                 const control::RotorFrameState<T>& x_input,
+                                 T v_bus_V) noexcept = 0;
+  /// Applies it and enables the stage.
+  virtual void write(const Modulation<T>& m) noexcept = 0;
+};
+
+}  // namespace imd::firmware

@@ -1,0 +1,42 @@
+#pragma once
+/// The tick's stages, and the clock that times them. Each stage's duration is kept in the tick
+/// record in counts of the control timer's execution clock (hal::ControlTimer), one read per
+/// stage; the telemetry and the simulation summary turn counts into time. Tick context.
+#include <array>
+#include <cstdint>
+
+#include "hal/control_timer.hpp"
+
+namespace imd::firmware {
+
+enum class Stage : uint8_t { sense, estimate, supervise, law, modulate, protect, actuate, publish };
+inline constexpr int kStageCount = 8;
+
+inline constexpr std::array<const char*, kStageCount> kStageNames = {
+    "sense", "estimate", "supervise", "law", "modulate", "protect", "actuate", "publish"};
+
+/// Durations of one tick's stages, in execution-clock counts.
+using StageCounts = std::array<uint32_t, kStageCount>;
+
+class StageClock {
+ public:
+  /// Starts timing a tick: the first read.
+  StageClock(const hal::ControlTimer& timer, StageCounts& counts) noexcept
+      : timer_(timer), counts_(counts), start_(timer.execution_counts()), last_(start_) {}
+
+  /// Ends `stage`: its duration is the time since the last lap.
+  void lap(Stage stage) noexcept {
+    const uint32_t now = timer_.execution_counts();
+    counts_[static_cast<int>(stage)] = now - last_;  // modulo 2^32: the counter may wrap
+    last_ = now;
+  }
+  /// Counts from the start of the tick to the last lap.
+  uint32_t total() const noexcept { return last_ - start_; }
+
+ private:
+  const hal::ControlTimer& timer_;
+  StageCounts& counts_;
+  uint32_t start_, last_;
+};
+
+}  // namespace imd::firmware

@@ -1,0 +1,151 @@
+#include "firmware/supervisor.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "firmware/duration_ticks.hpp"
+
+namespace imd::firmware {
+
+template <typename T>
+Supervisor<T>::Supervisor(const DriveConfig& config, const SupervisorWiring& wiring,
+                          const ReferenceSource<T>* references, LawRegistry<T>& laws,
+                          const Magnetizer<T>& magnetizer, bool predicts_latency,
+                          bool calibrated) noexcept
+    : commands_over_can_(config.commands_over_can),
+      auto_enable_(config.auto_enable),
+      enable_input_line_(config.enable_input_line),
+      wiring_(wiring),
+      commanded_(T(config.flux2_ref_Wb2), T(config.stator_flux2_ref_Wb2)),
+      references_(config.commands_over_can || references == nullptr ? commanded_ : *references),
+      laws_(laws),
+      magnetizer_(magnetizer),
+      predicts_latency_(predicts_latency),
+      controller_(config.controller),
+      decoder_(config.node_id, {float(config.protection.overspeed_rad_s),
+                                float(config.min_flux2_command_Wb2), float(config.max_flux2_Wb2)}),
+      ramp_(config.max_accel_rad_s2, config.sample_period_s),
+      command_accel_step_rad_s_(SpeedRamp<T>::step(config.max_accel_rad_s2, config.sample_period_s)),
+      stop_accel_step_rad_s_(SpeedRamp<T>::step(
+          std::min(config.max_accel_rad_s2, config.stop_decel_rad_s2), config.sample_period_s)),
+      stop_speed_rad_s_(T(config.stop_speed_rad_s)),
+      stop_timeout_ticks_(duration_ticks(config.stop_timeout_s, config.sample_period_s)),
+      calibrated_(calibrated) {
+  status_.controller = static_cast<uint8_t>(controller_);
+  if (calibrated_) {
+    machine_.go(DriveState::idle, TransitionReason::calibrated, 0);
+    TickPlan<T> unused;
+    if (auto_enable_) enable(0, unused);
+  }
+  status_.state = machine_.state();
+}
+
+template <typename T>
+bool Supervisor<T>::modulating() const noexcept {
+  const DriveState s = machine_.state();
+  return s == DriveState::magnetizing || s == DriveState::running || s == DriveState::stopping;
+}
+
+template <typename T>
+bool Supervisor<T>::read_enable_input() const noexcept {
+  const int line = enable_input_line_;
+  return wiring_.gpio == nullptr || line < 0 || wiring_.gpio->read(static_cast<uint8_t>(line));
+}
+
+template <typename T>
+TickPlan<T> Supervisor<T>::plan(uint64_t k, const Measurement<T>& m,
+                                const Estimate<T>& e) noexcept {
+  TickPlan<T> p;
+  enable_input_ = read_enable_input();  // before the commands: enable needs it
+  receive_commands(k, p);
+  if (machine_.state() == DriveState::calibrating && m.calibration == Calibration::done) {
+    calibrated_ = true;
+    machine_.go(DriveState::idle, TransitionReason::calibrated, k);
+    if (auto_enable_) enable(k + 1, p);
+  }
+  if (modulating() && e.valid) {
+    references(k, e, p);
+    const ControlledFlux flux = law().controlled_flux();
+    if (machine_.state() == DriveState::magnetizing) {
+      if (magnetizer_.magnetized(e.x, p.next, flux)) {
+        machine_.go(DriveState::running, TransitionReason::magnetized, k);
+        law().start(magnetizer_.current_AB_A(e.x_input, p.next, flux));
+      } else {
+        p.mode = Mode::magnetizing;
+      }
+    }
+    if (machine_.state() == DriveState::running || machine_.state() == DriveState::stopping) {
+      p.mode = Mode::controlling;
+      if (const uint32_t ahead = law().lookahead_ticks(); ahead > 0) {
+        p.ahead = references_.at_tick(k + ahead);
+        p.ahead.omega_mech_rad_s = p.next.omega_mech_rad_s;  // through the speed ramp
+        if (p.stopping) p.ahead.torque_Nm = T(0);
+      }
+    }
+    // A stop is complete once the ramp is at zero and the motor (nearly) still.
+    if (p.stopping && ((ramp_.value() == T(0) && std::abs(e.x.omega_mech_rad_s) < stop_speed_rad_s_) ||
+                       k - stop_start_tick_ > stop_timeout_ticks_)) {
+      machine_.go(DriveState::idle, TransitionReason::stopped, k);
+      p.mode = Mode::off;
+    }
+  } else if (e.valid) {
+    p.next = references_.at_tick(k);  // what the drive would aim at once enabled
+  }
+  SupervisedState& s = p.supervised;
+  s.modulating = modulating();
+  s.enable_input = enable_input_;
+  s.magnetizing = machine_.state() == DriveState::magnetizing;
+  s.magnetizing_ticks = k - magnetizing_start_tick_;
+  s.watchdog_armed = commands_over_can_ && (machine_.state() == DriveState::magnetizing ||
+                                            machine_.state() == DriveState::running);
+  s.command_silence_ticks = k - last_command_tick_;
+  return p;
+}
+
+template <typename T>
+void Supervisor<T>::references(uint64_t k, const Estimate<T>& e, TickPlan<T>& p) noexcept {
+  // References at x_input's step (now) and the step after (next), the speed through the ramp.
+  // Until the drive runs, a limited ramp follows the estimate and an unlimited one the
+  // reference, so that the reaching law acts on the real error from the first running tick.
+  // Stopping ramps the speed to zero at the stop deceleration.
+  p.stopping = machine_.state() == DriveState::stopping;
+  const bool stopping = p.stopping;
+  const uint64_t latency = predicts_latency_ ? 1 : 0;
+  auto speed_target = [&](uint64_t tick) {
+    return stopping ? T(0) : references_.at_tick(tick).omega_mech_rad_s;
+  };
+  if (machine_.state() == DriveState::magnetizing) {
+    ramp_.reset(ramp_.limited() ? e.x.omega_mech_rad_s : speed_target(k));
+  }
+  const T ramp_k1 = ramp_.next(ramp_.value(), speed_target(k + 1));
+  p.now = references_.at_tick(k + latency);
+  p.next = references_.at_tick(k + latency + 1);
+  p.now.omega_mech_rad_s = latency ? ramp_k1 : ramp_.value();
+  p.next.omega_mech_rad_s = latency ? ramp_.next(ramp_k1, speed_target(k + 2)) : ramp_k1;
+  if (stopping) p.now.torque_Nm = p.next.torque_Nm = T(0);
+  ramp_.reset(ramp_k1);
+}
+
+template <typename T>
+void Supervisor<T>::latch(const Trip& trip, uint64_t k) noexcept {
+  commanded_.set_speed(T(0));  // after clear and enable, the host sends a new speed
+  status_.fault_bits = static_cast<uint16_t>(status_.fault_bits | trip.bits);
+  if (machine_.state() == DriveState::fault) return;  // the first fault is kept
+  status_.first_fault = trip.first;
+  status_.first_fault_tick = k;
+  status_.fault_detail = trip.detail;
+  machine_.go(DriveState::fault, TransitionReason::fault, k);
+  status_.state = DriveState::fault;
+  if (wiring_.can != nullptr) wiring_.telemetry.report_fault(*wiring_.can, status_);
+}
+
+template <typename T>
+void Supervisor<T>::shut_down(uint64_t k) noexcept {
+  if (modulating()) machine_.go(DriveState::idle, TransitionReason::shutdown, k);
+  status_.state = machine_.state();
+}
+
+template class Supervisor<float>;
+template class Supervisor<double>;
+
+}  // namespace imd::firmware

@@ -1,0 +1,112 @@
+#pragma once
+/// The supervise stage: the drive's state machine (firmware/state_machine.hpp) and its command
+/// handling. Every state transition happens here: commands from CAN, the end of the ADC
+/// calibration, the magnetizing start-up handing over to the law, the end of a stop, and the
+/// faults the protect stage found (latch). It also shapes the references the law sees: the
+/// speed through the acceleration ramp, at the steps the law's input acts on. Its output, the
+/// TickPlan, tells the law stage what to run. Tick context except construction.
+#include <cstdint>
+
+#include "control/frames.hpp"
+#include "firmware/commanded_reference.hpp"
+#include "firmware/drive_config.hpp"
+#include "firmware/drive_state.hpp"
+#include "firmware/laws/law_registry.hpp"
+#include "firmware/protection/protection.hpp"
+#include "firmware/protection/trip.hpp"
+#include "firmware/protocol/commands.hpp"
+#include "firmware/reference_source.hpp"
+#include "firmware/speed_ramp.hpp"
+#include "firmware/stages/estimate.hpp"
+#include "firmware/stages/magnetizer.hpp"
+#include "firmware/stages/measurement.hpp"
+#include "firmware/state_machine.hpp"
+#include "firmware/telemetry.hpp"
+#include "hal/can_bus.hpp"
+#include "hal/gpio.hpp"
+
+namespace imd::firmware {
+
+/// What the law stage runs this tick.
+enum class Mode : uint8_t {
+  off,          ///< the PWM is off (calibrating, idle, fault)
+  magnetizing,  ///< the magnetizing current
+  controlling,  ///< the selected law (running or stopping)
+};
+
+template <typename T>
+struct TickPlan {
+  Mode mode = Mode::off;
+  bool stopping = false;
+  /// References at the input's step and the step after (the speed through the ramp), and the
+  /// law's lookahead; while off, `next` is the reference of this tick (for telemetry).
+  Reference<T> now, next, ahead;
+  SupervisedState supervised;  ///< for the checks
+};
+
+/// Where the supervisor's commands and events go.
+struct SupervisorWiring {
+  hal::CanBus* can = nullptr;
+  hal::Gpio* gpio = nullptr;
+  Telemetry& telemetry;
+};
+
+template <typename T>
+class Supervisor {
+ public:
+  /// `references`: the reference source unless the config takes references from CAN commands.
+  /// `calibrated`: the ADC offsets are known without a calibration.
+  Supervisor(const DriveConfig& config, const SupervisorWiring& wiring,
+             const ReferenceSource<T>* references, LawRegistry<T>& laws,
+             const Magnetizer<T>& magnetizer, bool predicts_latency, bool calibrated) noexcept;
+
+  /// Commands, then the transitions the measurement and the estimate call for, then the
+  /// references.
+  TickPlan<T> plan(uint64_t k, const Measurement<T>& m, const Estimate<T>& e) noexcept;
+  /// Latches the faults the protect stage found (the first one keeps its code and time). The
+  /// caller turns the PWM off.
+  void latch(const Trip& trip, uint64_t k) noexcept;
+  /// The program running the drive ends: to idle if modulating (the motor coasts).
+  void shut_down(uint64_t k) noexcept;
+
+  DriveState state() const noexcept { return machine_.state(); }
+  bool modulating() const noexcept;
+  const DriveStatus& status() const noexcept { return status_; }
+  DriveStatus& status() noexcept { return status_; }
+  const StateMachine& machine() const noexcept { return machine_; }
+  const protocol::CommandDecoder& decoder() const noexcept { return decoder_; }
+  ControlLaw<T>& law() noexcept { return laws_.law(controller_); }
+  const ControlLaw<T>& law() const noexcept { return laws_.law(controller_); }
+
+ private:
+  void references(uint64_t k, const Estimate<T>& e, TickPlan<T>& p) noexcept;
+  // Commands (supervisor_commands.cpp).
+  void receive_commands(uint64_t k, TickPlan<T>& p) noexcept;
+  protocol::CommandResult apply(const protocol::Command& command, uint64_t k,
+                                TickPlan<T>& p) noexcept;
+  void enable(uint64_t k, TickPlan<T>& p) noexcept;
+  void clear_faults(uint64_t k, TickPlan<T>& p) noexcept;
+  bool read_enable_input() const noexcept;
+
+  bool commands_over_can_, auto_enable_;
+  int enable_input_line_;
+  SupervisorWiring wiring_;
+  CommandedReference<T> commanded_;
+  const ReferenceSource<T>& references_;  ///< commanded_ or the given source
+  LawRegistry<T>& laws_;
+  const Magnetizer<T>& magnetizer_;
+  bool predicts_latency_;
+  ControllerKind controller_;
+  StateMachine machine_;
+  DriveStatus status_;
+  protocol::CommandDecoder decoder_;
+  SpeedRamp<T> ramp_;
+  T command_accel_step_rad_s_, stop_accel_step_rad_s_;  ///< per period
+  T stop_speed_rad_s_;
+  uint64_t stop_timeout_ticks_;
+  bool calibrated_;
+  bool enable_input_ = true;  ///< read at the start of the stage
+  uint64_t magnetizing_start_tick_ = 0, last_command_tick_ = 0, stop_start_tick_ = 0;
+};
+
+}  // namespace imd::firmware
