@@ -65,7 +65,7 @@ template <typename T>
 Estimate<T> Drive<T>::estimate(const Measurement<T>& m) noexcept {
   if (!m.valid) return {};
   Estimate<T> e = estimator_.estimate(m);
-  e.x_input = predictor_.input_state(e);
+  predictor_.set_input_state(e);
   return e;
 }
 
@@ -74,11 +74,11 @@ LawOutput<T> Drive<T>::law(const TickPlan<T>& plan, const Estimate<T>& e, T v_bu
   record_.law.speed_saturated = record_.law.flux_saturated = record_.law.iol_boundary = false;
   if (plan.mode == Mode::off) return {};
   const control::InputDisk<T> feasible = limits_.feasible(e.x_input, v_bus_V);
-  ControlLaw<T>& law = supervisor_.law();
   if (plan.mode == Mode::magnetizing) {
-    return magnetizer_.step(e.x_input, plan.next, law.controlled_flux(), feasible);
+    return magnetizer_.step(e.x_input, plan.next, supervisor_.controlled_flux(), feasible);
   }
-  return law.step({e, plan.now, plan.next, plan.ahead, plan.stopping, feasible}, record_.law);
+  return supervisor_.law().step({e, plan.now, plan.next, plan.ahead, plan.stopping, feasible},
+                                record_.law);
 }
 
 template <typename T>
@@ -124,7 +124,7 @@ void Drive<T>::publish(uint64_t k, const Measurement<T>& m, const Estimate<T>& e
   r.v_bus_V = m.v_bus_V;
   r.voltage_clipped = out.clipped;
   if (e.valid) {
-    const ControlledFlux flux = supervisor_.law().controlled_flux();
+    const ControlledFlux flux = supervisor_.controlled_flux();
     r.i_alphabeta_A = m.i_alphabeta_A;
     r.omega_est_rad_s = e.x.omega_mech_rad_s;
     r.theta_est_rad = e.x.theta_mech_rad;

@@ -31,13 +31,21 @@ Supervisor<T>::Supervisor(const DriveConfig& config, const SupervisorWiring& wir
       stop_speed_rad_s_(T(config.stop_speed_rad_s)),
       stop_timeout_ticks_(duration_ticks(config.stop_timeout_s, config.sample_period_s)),
       calibrated_(calibrated) {
-  status_.controller = static_cast<uint8_t>(controller_);
+  select(config.controller);
   if (calibrated_) {
     machine_.go(DriveState::idle, TransitionReason::calibrated, 0);
     TickPlan<T> unused;
     if (auto_enable_) enable(0, unused);
   }
   status_.state = machine_.state();
+}
+
+template <typename T>
+void Supervisor<T>::select(ControllerKind kind) noexcept {
+  controller_ = kind;
+  controlled_flux_ = law().controlled_flux();
+  lookahead_ticks_ = law().lookahead_ticks();
+  status_.controller = static_cast<uint8_t>(kind);
 }
 
 template <typename T>
@@ -65,7 +73,7 @@ TickPlan<T> Supervisor<T>::plan(uint64_t k, const Measurement<T>& m,
   }
   if (modulating() && e.valid) {
     references(k, e, p);
-    const ControlledFlux flux = law().controlled_flux();
+    const ControlledFlux flux = controlled_flux_;
     if (machine_.state() == DriveState::magnetizing) {
       if (magnetizer_.magnetized(e.x, p.next, flux)) {
         machine_.go(DriveState::running, TransitionReason::magnetized, k);
@@ -76,8 +84,8 @@ TickPlan<T> Supervisor<T>::plan(uint64_t k, const Measurement<T>& m,
     }
     if (machine_.state() == DriveState::running || machine_.state() == DriveState::stopping) {
       p.mode = Mode::controlling;
-      if (const uint32_t ahead = law().lookahead_ticks(); ahead > 0) {
-        p.ahead = references_.at_tick(k + ahead);
+      if (lookahead_ticks_ > 0) {
+        p.ahead = references_.at_tick(k + lookahead_ticks_);
         p.ahead.omega_mech_rad_s = p.next.omega_mech_rad_s;  // through the speed ramp
         if (p.stopping) p.ahead.torque_Nm = T(0);
       }

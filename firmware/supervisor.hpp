@@ -77,6 +77,8 @@ class Supervisor {
   const protocol::CommandDecoder& decoder() const noexcept { return decoder_; }
   ControlLaw<T>& law() noexcept { return laws_.law(controller_); }
   const ControlLaw<T>& law() const noexcept { return laws_.law(controller_); }
+  /// The selected law's flux (kept at selection: the tick asks for it several times).
+  ControlledFlux controlled_flux() const noexcept { return controlled_flux_; }
 
  private:
   void references(uint64_t k, const Estimate<T>& e, TickPlan<T>& p) noexcept;
@@ -87,6 +89,7 @@ class Supervisor {
   void enable(uint64_t k, TickPlan<T>& p) noexcept;
   void clear_faults(uint64_t k, TickPlan<T>& p) noexcept;
   bool read_enable_input() const noexcept;
+  void select(ControllerKind kind) noexcept;
 
   bool commands_over_can_, auto_enable_;
   int enable_input_line_;
@@ -97,6 +100,8 @@ class Supervisor {
   const Magnetizer<T>& magnetizer_;
   bool predicts_latency_;
   ControllerKind controller_;
+  ControlledFlux controlled_flux_;  ///< of the selected law
+  uint32_t lookahead_ticks_;        ///< of the selected law
   StateMachine machine_;
   DriveStatus status_;
   protocol::CommandDecoder decoder_;

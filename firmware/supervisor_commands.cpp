@@ -83,7 +83,7 @@ protocol::CommandResult Supervisor<T>::apply(const protocol::Command& c, uint64_
       return CommandResult::accepted;
     case CommandKind::set_flux:
       if (!commands_over_can_) return CommandResult::not_allowed;
-      if (law().controlled_flux() == ControlledFlux::stator) {
+      if (controlled_flux_ == ControlledFlux::stator) {
         commanded_.set_stator_flux2(T(c.value));
       } else {
         commanded_.set_flux2(T(c.value));
@@ -96,8 +96,7 @@ protocol::CommandResult Supervisor<T>::apply(const protocol::Command& c, uint64_
       // Only at rest; a law that follows no speed reference only with references of its own.
       const bool speed_capable = laws_.law(wanted).follows_speed() || !commands_over_can_;
       if (s != DriveState::idle || !speed_capable) return CommandResult::not_allowed;
-      controller_ = wanted;
-      status_.controller = static_cast<uint8_t>(wanted);
+      select(wanted);
       return CommandResult::accepted;
     }
     case CommandKind::set_telemetry_rate:

@@ -49,26 +49,29 @@ class ObserverEstimator final : public StateEstimator<T> {
   Estimate<T> estimate(const Measurement<T>& m) noexcept override {
     if (m.encoder_first) encoder_.reset(m.theta_encoder_rad);
     encoder_.correct(m.theta_encoder_rad);
-    last_.valid = true;
-    last_.x.theta_mech_rad = encoder_.theta_mech_rad();
-    last_.x.omega_mech_rad_s = encoder_.omega_mech_rad_s();
-    last_.x.flux_r_AB_Wb = flux_.flux_r_AB_Wb();
-    last_.load_Nm = encoder_.load_Nm();
-    last_.x.i_s_AB_A = control::Rotation<T>::from_angle(pole_pairs_ * last_.x.theta_mech_rad)
-                           .apply_inverse(m.i_alphabeta_A);
-    return last_;
+    Estimate<T> e;
+    e.valid = true;
+    e.x.theta_mech_rad = encoder_.theta_mech_rad();
+    e.x.omega_mech_rad_s = encoder_.omega_mech_rad_s();
+    e.x.flux_r_AB_Wb = flux_.flux_r_AB_Wb();
+    e.load_Nm = encoder_.load_Nm();
+    e.x.i_s_AB_A = control::Rotation<T>::from_angle(pole_pairs_ * e.x.theta_mech_rad)
+                       .apply_inverse(m.i_alphabeta_A);
+    i_s_AB_A_ = e.x.i_s_AB_A;
+    return e;
   }
 
   void advance(const control::Vec2<T>& v_acting_AB_V) noexcept override {
-    flux_.update(last_.x.i_s_AB_A, v_acting_AB_V);
-    encoder_.predict(last_.x.i_s_AB_A, last_.x.flux_r_AB_Wb, v_acting_AB_V);
+    // The flux observer still holds the estimate of this tick until its update.
+    encoder_.predict(i_s_AB_A_, flux_.flux_r_AB_Wb(), v_acting_AB_V);
+    flux_.update(i_s_AB_A_, v_acting_AB_V);
   }
 
  private:
   control::FluxObserver<T> flux_;
   control::EncoderObserver<T> encoder_;
   T pole_pairs_;
-  Estimate<T> last_;
+  control::Vec2<T> i_s_AB_A_ = control::Vec2<T>::Zero();  ///< of the last estimate
 };
 
 }  // namespace imd::firmware

@@ -20,12 +20,10 @@ class LatencyPredictor {
   /// Whether the input chosen now acts one tick later than the state it is chosen from.
   bool predicts() const noexcept { return predict_; }
 
-  /// The state the input of this tick will act on.
-  control::RotorFrameState<T> input_state(const Estimate<T>& e) const noexcept {
-    control::RotorFrameState<T> x = e.x;
-    if (predict_) x = model_.predict(e.x, v_in_flight_V_, e.load_Nm);
-    x.theta_mech_rad = control::wrap_pi(x.theta_mech_rad);
-    return x;
+  /// Sets e.x_input, the state the input of this tick will act on.
+  void set_input_state(Estimate<T>& e) const noexcept {
+    e.x_input = predict_ ? model_.predict(e.x, v_in_flight_V_, e.load_Nm) : e.x;
+    e.x_input.theta_mech_rad = control::wrap_pi(e.x_input.theta_mech_rad);
   }
 
   /// This tick's voltage `v_V` is written (zero if the PWM is off). Returns the voltage acting
