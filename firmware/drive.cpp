@@ -30,7 +30,7 @@ Drive<T>::Drive(const control::MotorParameters& motor, const DriveConfig& config
       supervisor_(config, {peripherals.can, peripherals.gpio, telemetry_}, substitutes.references,
                   laws_, magnetizer_, predictor_.predicts(), config.adc_calibration_ticks <= 0),
       clock_Hz_(peripherals.timer.execution_clock_Hz()),
-      ns_per_count_q16_(static_cast<uint64_t>(std::llround(65536e9 / double(clock_Hz_)))) {
+      ns_per_count_(static_cast<float>(1e9 / double(clock_Hz_))) {
   protection_.set_clock(clock_Hz_);
   hw_.pwm.disable();
 }
@@ -38,7 +38,9 @@ Drive<T>::Drive(const control::MotorParameters& motor, const DriveConfig& config
 template <typename T>
 void Drive<T>::on_tick() noexcept {
   write_line(config_.timing_output_line, true);
-  StageClock clock(hw_.timer, record_.stage_counts);
+  record_.stages_timed = ++ticks_since_timed_ >= config_.stage_timing_period_ticks;
+  if (record_.stages_timed) ticks_since_timed_ = 0;
+  StageClock clock(hw_.timer, record_.stage_counts, record_.stages_timed);
   const uint64_t k = hw_.timer.tick_count();
   const Measurement<T> m = sensing_.measure(supervisor_.state() == DriveState::calibrating);
   clock.lap(Stage::sense);
@@ -54,15 +56,14 @@ void Drive<T>::on_tick() noexcept {
   const Trip trip = protection_.check(m, e, plan.supervised, u, out, u_written_V_);
   clock.lap(Stage::protect);
   actuate(k, e, out, trip);
-  clock.lap(Stage::actuate);
-  check_budget(k, clock.total());
+  check_budget(k, clock.lap_total(Stage::actuate));
   publish(k, m, e, plan, u, out);
   clock.lap(Stage::publish);
   write_line(config_.timing_output_line, false);
 }
 
 template <typename T>
-Estimate<T> Drive<T>::estimate(const Measurement<T>& m) noexcept {
+inline Estimate<T> Drive<T>::estimate(const Measurement<T>& m) noexcept {
   if (!m.valid) return {};
   Estimate<T> e = estimator_.estimate(m);
   predictor_.set_input_state(e);
@@ -70,7 +71,7 @@ Estimate<T> Drive<T>::estimate(const Measurement<T>& m) noexcept {
 }
 
 template <typename T>
-LawOutput<T> Drive<T>::law(const TickPlan<T>& plan, const Estimate<T>& e, T v_bus_V) noexcept {
+inline LawOutput<T> Drive<T>::law(const TickPlan<T>& plan, const Estimate<T>& e, T v_bus_V) noexcept {
   record_.law.speed_saturated = record_.law.flux_saturated = record_.law.iol_boundary = false;
   if (plan.mode == Mode::off) return {};
   const control::InputDisk<T> feasible = limits_.feasible(e.x_input, v_bus_V);
@@ -82,7 +83,7 @@ LawOutput<T> Drive<T>::law(const TickPlan<T>& plan, const Estimate<T>& e, T v_bu
 }
 
 template <typename T>
-void Drive<T>::actuate(uint64_t k, const Estimate<T>& e, const Modulation<T>& out,
+inline void Drive<T>::actuate(uint64_t k, const Estimate<T>& e, const Modulation<T>& out,
                        const Trip& trip) noexcept {
   v_applied_V_ = Vec2::Zero();
   if (trip.any()) {
@@ -103,9 +104,9 @@ void Drive<T>::actuate(uint64_t k, const Estimate<T>& e, const Modulation<T>& ou
 }
 
 template <typename T>
-void Drive<T>::check_budget(uint64_t k, uint32_t counts) noexcept {
-  const uint64_t exec_ns = (uint64_t(counts) * ns_per_count_q16_) >> 16;
-  record_.exec_ns = static_cast<uint32_t>(std::min<uint64_t>(exec_ns, UINT32_MAX));
+inline void Drive<T>::check_budget(uint64_t k, uint32_t counts) noexcept {
+  const float exec_ns = float(counts) * ns_per_count_;  // within float's 2^-24
+  record_.exec_ns = exec_ns < 4e9f ? static_cast<uint32_t>(exec_ns) : UINT32_MAX;
   execution_.add(record_.exec_ns);
   const Trip overrun = protection_.over_budget(counts);
   if (!overrun.any()) return;
@@ -116,7 +117,7 @@ void Drive<T>::check_budget(uint64_t k, uint32_t counts) noexcept {
 }
 
 template <typename T>
-void Drive<T>::publish(uint64_t k, const Measurement<T>& m, const Estimate<T>& e,
+inline void Drive<T>::publish(uint64_t k, const Measurement<T>& m, const Estimate<T>& e,
                        const TickPlan<T>& plan, const LawOutput<T>& u,
                        const Modulation<T>& out) noexcept {
   TickRecord<T>& r = record_;

@@ -64,6 +64,9 @@ struct DriveConfig {
   double min_flux2_Wb2 = 1e-3;        ///< below it B_k counts as singular
 
   ProtectionConfig protection;
+  /// The tick's stages are timed on one tick in this many (1: every tick); the whole tick is
+  /// timed on every tick for its budget.
+  int stage_timing_period_ticks = 8;
 
   // Commands and telemetry (docs/can/protocol.md).
   uint8_t node_id = 1;

@@ -6,6 +6,14 @@
 #include "firmware/duration_ticks.hpp"
 
 namespace imd::firmware {
+namespace {
+
+/// Ticks since an event, in 32 bits (5 days at 10 kHz), saturating.
+uint32_t saturated_ticks(uint64_t ticks) noexcept {
+  return ticks < UINT32_MAX ? static_cast<uint32_t>(ticks) : UINT32_MAX;
+}
+
+}  // namespace
 
 template <typename T>
 Supervisor<T>::Supervisor(const DriveConfig& config, const SupervisorWiring& wiring,
@@ -64,6 +72,8 @@ template <typename T>
 TickPlan<T> Supervisor<T>::plan(uint64_t k, const Measurement<T>& m,
                                 const Estimate<T>& e) noexcept {
   TickPlan<T> p;
+  p.mode = Mode::off;
+  p.stopping = false;
   enable_input_ = read_enable_input();  // before the commands: enable needs it
   receive_commands(k, p);
   if (machine_.state() == DriveState::calibrating && m.calibration == Calibration::done) {
@@ -103,15 +113,15 @@ TickPlan<T> Supervisor<T>::plan(uint64_t k, const Measurement<T>& m,
   s.modulating = modulating();
   s.enable_input = enable_input_;
   s.magnetizing = machine_.state() == DriveState::magnetizing;
-  s.magnetizing_ticks = k - magnetizing_start_tick_;
+  s.magnetizing_ticks = saturated_ticks(k - magnetizing_start_tick_);
   s.watchdog_armed = commands_over_can_ && (machine_.state() == DriveState::magnetizing ||
                                             machine_.state() == DriveState::running);
-  s.command_silence_ticks = k - last_command_tick_;
+  s.command_silence_ticks = saturated_ticks(k - last_command_tick_);
   return p;
 }
 
 template <typename T>
-void Supervisor<T>::references(uint64_t k, const Estimate<T>& e, TickPlan<T>& p) noexcept {
+inline void Supervisor<T>::references(uint64_t k, const Estimate<T>& e, TickPlan<T>& p) noexcept {
   // References at x_input's step (now) and the step after (next), the speed through the ramp.
   // Until the drive runs, a limited ramp follows the estimate and an unlimited one the
   // reference, so that the reaching law acts on the real error from the first running tick.
@@ -119,17 +129,20 @@ void Supervisor<T>::references(uint64_t k, const Estimate<T>& e, TickPlan<T>& p)
   p.stopping = machine_.state() == DriveState::stopping;
   const bool stopping = p.stopping;
   const uint64_t latency = predicts_latency_ ? 1 : 0;
-  auto speed_target = [&](uint64_t tick) {
-    return stopping ? T(0) : references_.at_tick(tick).omega_mech_rad_s;
-  };
+  // Each tick's reference is read once: k + 1 and k + 2 serve both the ramp and the law.
+  const Reference<T> at_k1 = references_.at_tick(k + 1);
+  const Reference<T> at_k2 = references_.at_tick(k + 2);
+  const T target_k1 = stopping ? T(0) : at_k1.omega_mech_rad_s;
+  const T target_k2 = stopping ? T(0) : at_k2.omega_mech_rad_s;
   if (machine_.state() == DriveState::magnetizing) {
-    ramp_.reset(ramp_.limited() ? e.x.omega_mech_rad_s : speed_target(k));
+    ramp_.reset(ramp_.limited() ? e.x.omega_mech_rad_s
+                                : (stopping ? T(0) : references_.at_tick(k).omega_mech_rad_s));
   }
-  const T ramp_k1 = ramp_.next(ramp_.value(), speed_target(k + 1));
-  p.now = references_.at_tick(k + latency);
-  p.next = references_.at_tick(k + latency + 1);
+  const T ramp_k1 = ramp_.next(ramp_.value(), target_k1);
+  p.now = latency ? at_k1 : references_.at_tick(k);
+  p.next = latency ? at_k2 : at_k1;
   p.now.omega_mech_rad_s = latency ? ramp_k1 : ramp_.value();
-  p.next.omega_mech_rad_s = latency ? ramp_.next(ramp_k1, speed_target(k + 2)) : ramp_k1;
+  p.next.omega_mech_rad_s = latency ? ramp_.next(ramp_k1, target_k2) : ramp_k1;
   if (stopping) p.now.torque_Nm = p.next.torque_Nm = T(0);
   ramp_.reset(ramp_k1);
 }

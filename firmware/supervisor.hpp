@@ -36,8 +36,8 @@ enum class Mode : uint8_t {
 
 template <typename T>
 struct TickPlan {
-  Mode mode = Mode::off;
-  bool stopping = false;
+  Mode mode;
+  bool stopping;
   /// References at the input's step and the step after (the speed through the ramp), and the
   /// law's lookahead; while off, `next` is the reference of this tick (for telemetry).
   Reference<T> now, next, ahead;
@@ -81,7 +81,8 @@ class Supervisor {
   ControlledFlux controlled_flux() const noexcept { return controlled_flux_; }
 
  private:
-  void references(uint64_t k, const Estimate<T>& e, TickPlan<T>& p) noexcept;
+  [[gnu::always_inline]] void references(uint64_t k, const Estimate<T>& e,
+                                         TickPlan<T>& p) noexcept;
   // Commands (supervisor_commands.cpp).
   void receive_commands(uint64_t k, TickPlan<T>& p) noexcept;
   protocol::CommandResult apply(const protocol::Command& command, uint64_t k,

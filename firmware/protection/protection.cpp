@@ -7,6 +7,11 @@
 namespace imd::firmware {
 namespace {
 
+/// A tick count in 32 bits: beyond 2^32 - 1 ticks (5 days at 10 kHz), no timeout.
+uint32_t saturated(uint64_t ticks) noexcept {
+  return ticks < UINT32_MAX ? static_cast<uint32_t>(ticks) : UINT32_MAX;
+}
+
 template <typename T>
 bool finite(const control::Vec2<T>& v) noexcept {
   return std::isfinite(v.x()) && std::isfinite(v.y());
@@ -26,10 +31,10 @@ Protection<T>::Protection(const control::MotorParameters& motor, const DriveConf
       pole_pairs_(T(motor.pole_pairs)),
       torque_per_AWb_(
           T(control::kClarkeTorqueFactor * motor.pole_pairs * motor.Lm_H / motor.Lr_H)),
-      magnetizing_timeout_ticks_(
-          duration_ticks(config.magnetizing_timeout_s, config.sample_period_s)),
-      command_timeout_ticks_(
-          duration_ticks(config.protection.command_timeout_s, config.sample_period_s)),
+      magnetizing_timeout_ticks_(saturated(
+          duration_ticks(config.magnetizing_timeout_s, config.sample_period_s))),
+      command_timeout_ticks_(saturated(
+          duration_ticks(config.protection.command_timeout_s, config.sample_period_s))),
       encoder_check_({counts_per_rev, config.sample_period_s, motor.J_kgm2, motor.friction_Nms,
                       config.protection.encoder_missing_counts,
                       config.protection.encoder_window_s, config.protection.overspeed_rad_s}),
@@ -79,7 +84,7 @@ Trip Protection<T>::check(const Measurement<T>& m, const Estimate<T>& e, const S
 }
 
 template <typename T>
-void Protection<T>::check_sensed(const Measurement<T>& m, const Estimate<T>& e, bool modulating,
+inline void Protection<T>::check_sensed(const Measurement<T>& m, const Estimate<T>& e, bool modulating,
                                  Trip& trip) noexcept {
   if (m.i_peak_A > overcurrent_A_ || m.adc_saturated) {
     int phase = 0;
@@ -104,7 +109,7 @@ void Protection<T>::check_sensed(const Measurement<T>& m, const Estimate<T>& e, 
 }
 
 template <typename T>
-void Protection<T>::check_driving(const Measurement<T>& m, const Estimate<T>& e,
+inline void Protection<T>::check_driving(const Measurement<T>& m, const Estimate<T>& e,
                                   const SupervisedState& s, const control::Vec2<T>& u_last_V,
                                   Trip& trip) noexcept {
   if (!(m.v_bus_V >= bus_min_V_)) trip.add(FaultCode::bus_undervoltage);  // NaN too

@@ -29,13 +29,13 @@ namespace imd::firmware {
 
 /// What the supervisor knows that the checks need (TickPlan carries it).
 struct SupervisedState {
-  bool modulating = false;    ///< magnetizing, running or stopping: the inverter drives
-  bool enable_input = true;   ///< the board's enable input (true without one)
-  bool restarted = false;     ///< enabled or cleared this tick: the checks start afresh
-  uint64_t magnetizing_ticks = 0;  ///< ticks since magnetizing began (while magnetizing)
+  bool modulating = false;     ///< magnetizing, running or stopping: the inverter drives
+  bool enable_input = true;    ///< the board's enable input (true without one)
+  bool restarted = false;      ///< enabled or cleared this tick: the checks start afresh
   bool magnetizing = false;
-  bool watchdog_armed = false;     ///< CAN-commanded and magnetizing or running
-  uint64_t command_silence_ticks = 0;  ///< since the last valid command
+  bool watchdog_armed = false;  ///< CAN-commanded and magnetizing or running
+  uint32_t magnetizing_ticks = 0;      ///< since magnetizing began (saturates)
+  uint32_t command_silence_ticks = 0;  ///< since the last valid command (saturates)
 };
 
 template <typename T>
@@ -54,16 +54,16 @@ class Protection {
   void set_clock(uint32_t clock_Hz) noexcept;
 
  private:
-  void check_sensed(const Measurement<T>& m, const Estimate<T>& e, bool modulating,
+  [[gnu::always_inline]] void check_sensed(const Measurement<T>& m, const Estimate<T>& e, bool modulating,
                     Trip& trip) noexcept;
-  void check_driving(const Measurement<T>& m, const Estimate<T>& e, const SupervisedState& s,
+  [[gnu::always_inline]] void check_driving(const Measurement<T>& m, const Estimate<T>& e, const SupervisedState& s,
                      const control::Vec2<T>& u_last_V, Trip& trip) noexcept;
 
   ProtectionConfig config_;
   bool commands_over_can_;
   T overcurrent_A_, bus_min_V_, bus_max_V_, overspeed_rad_s_;
   T pole_pairs_, torque_per_AWb_;
-  uint64_t magnetizing_timeout_ticks_, command_timeout_ticks_;
+  uint32_t magnetizing_timeout_ticks_, command_timeout_ticks_;
   uint32_t budget_counts_ = 0;
   EncoderCheck<T> encoder_check_;
   AdcStuckCheck<T> adc_stuck_check_;

@@ -33,15 +33,10 @@ MessageId message_for(CommandKind kind) noexcept {
   return MessageId::disable;
 }
 
-uint32_t CommandDecoder::rejected_total() const noexcept {
-  uint32_t total = 0;
-  for (int i = 1; i < kCommandResultCount; ++i) total += rejections_[i];
-  return total;
-}
-
 Decoded CommandDecoder::reject(Decoded d, CommandResult reason) noexcept {
   d.result = reason;
   ++rejections_[int(reason)];
+  ++rejected_total_;
   return d;
 }
 

@@ -74,10 +74,14 @@ class CommandDecoder {
   Decoded decode(const hal::CanFrame& frame) noexcept;
 
   /// A command the application refuses in its present state: counted like a rejection.
-  void count_not_allowed() noexcept { ++rejections_[int(CommandResult::not_allowed)]; }
+  void count_not_allowed() noexcept {
+    ++rejections_[int(CommandResult::not_allowed)];
+    ++rejected_total_;
+  }
 
   uint32_t rejected(CommandResult reason) const noexcept { return rejections_[int(reason)]; }
-  uint32_t rejected_total() const noexcept;
+  /// Every rejection so far (kept as it counts: the tick reports it every period).
+  uint32_t rejected_total() const noexcept { return rejected_total_; }
   uint8_t last_counter() const noexcept { return last_counter_; }
 
  private:
@@ -88,6 +92,7 @@ class CommandDecoder {
   bool have_counter_ = false;
   uint8_t last_counter_ = 0;
   std::array<uint32_t, kCommandResultCount> rejections_{};
+  uint32_t rejected_total_ = 0;
 };
 
 /// The host side: typed commands to frames with the next alive counter and the CRC.

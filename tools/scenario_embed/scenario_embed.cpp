@@ -24,7 +24,7 @@ using imd::firmware::ControllerKind;
 using imd::firmware::DriveConfig;
 
 // A new field must be written here too: these sizes fail the build until it is.
-static_assert(sizeof(DriveConfig) == 376, "DriveConfig changed: write its new fields below");
+static_assert(sizeof(DriveConfig) == 384, "DriveConfig changed: write its new fields below");
 static_assert(sizeof(imd::sim::SimBoardConfig) == 112, "SimBoardConfig changed: write it below");
 static_assert(sizeof(imd::control::MotorParameters) == 64, "MotorParameters changed");
 
@@ -157,6 +157,7 @@ void write_drive(Writer& w, const DriveConfig& c) {
   w.number("drive.protection.phase_loss_max_window_s", p.phase_loss_max_window_s);
   w.number("drive.protection.command_timeout_s", p.command_timeout_s);
   w.line("drive.protection.tick_budget_ns", fmt::format("{}u", p.tick_budget_ns));
+  w.integer("drive.stage_timing_period_ticks", c.stage_timing_period_ticks);
   w.integer("drive.node_id", c.node_id);
   w.boolean("drive.commands_over_can", c.commands_over_can);
   w.boolean("drive.auto_enable", c.auto_enable);

@@ -91,7 +91,7 @@ int run(const EmbeddedScenario& s, cm::CmsdkUart& console) {
     const TickRecord<float>& rec = drive.record();
     while (board.can_side().take_sent(frame)) ++frames_sent;  // the host side reads the bus
     if (running_from_s < 0 && rec.state == DriveState::running) running_from_s = t_s;
-    stage_totals.add(rec.stage_counts);
+    if (rec.stages_timed) stage_totals.add(rec.stage_counts);
     metrics.add(tracking_sample(s, truth, load_Nm, rec, t_s));
     board.end_period();
     references.fill_from(k + 1);

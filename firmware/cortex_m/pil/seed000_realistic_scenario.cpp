@@ -75,6 +75,7 @@ const EmbeddedScenario kSeed000Realistic = [] {
   s.drive.protection.phase_loss_max_window_s = 1;
   s.drive.protection.command_timeout_s = 0.20000000000000001;
   s.drive.protection.tick_budget_ns = 0u;
+  s.drive.stage_timing_period_ticks = 8;
   s.drive.node_id = 1;
   s.drive.commands_over_can = false;
   s.drive.auto_enable = true;
