@@ -9,9 +9,11 @@ namespace imd::firmware {
 using protocol::encode_frame;
 using protocol::MessageId;
 
-Telemetry::Telemetry(uint8_t node_id, uint32_t period_ns, int rate_Hz) noexcept
+Telemetry::Telemetry(uint8_t node_id, uint32_t period_ns, int rate_Hz,
+                     float ns_per_count) noexcept
     : node_id_(node_id),
       period_ns_(period_ns),
+      us_per_count_(ns_per_count * 1e-3f),
       ticks_per_10Hz_(std::max<uint64_t>(1, 100'000'000ull / period_ns)),
       next_timing_k_(ticks_per_10Hz_ / 2) {
   if (!set_rate_Hz(rate_Hz)) set_rate_Hz(100);
@@ -64,6 +66,7 @@ void Telemetry::publish(uint64_t k, hal::CanBus& can, const TickRecord<T>& r,
                            {float(execution.mean_whole_ns()) * 1e-3f, float(execution.max_ns) * 1e-3f,
                             float(std::min<uint64_t>(execution.overruns, 0xFFFF)),
                             float(budget_ns) * 1e-3f}));
+    send_stage_timing(can, r.stage_counts);
   }
   if (k >= next_fast_k_) {
     next_fast_k_ = next_due(next_fast_k_, k, fast_period_ticks_);
@@ -86,6 +89,14 @@ template void Telemetry::publish(uint64_t, hal::CanBus&, const TickRecord<float>
 template void Telemetry::publish(uint64_t, hal::CanBus&, const TickRecord<double>&,
                                  const DriveStatus&, const StateMachine&, const ExecutionStats&,
                                  uint32_t) noexcept;
+
+void Telemetry::send_stage_timing(hal::CanBus& can, const StageCounts& c) noexcept {
+  const float u = us_per_count_;
+  send(can, encode_frame(node_id_, MessageId::stage_timing_1,
+                         {float(c[0]) * u, float(c[1]) * u, float(c[2]) * u, float(c[3]) * u}));
+  send(can, encode_frame(node_id_, MessageId::stage_timing_2,
+                         {float(c[4]) * u, float(c[5]) * u, float(c[6]) * u, float(c[7]) * u}));
+}
 
 void Telemetry::final_heartbeat(hal::CanBus& can, const DriveStatus& status,
                                 const StateMachine& machine) noexcept {

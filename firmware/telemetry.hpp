@@ -30,8 +30,9 @@ struct DriveStatus {
 
 class Telemetry {
  public:
-  /// `period_ns`: the control period.
-  Telemetry(uint8_t node_id, uint32_t period_ns, int rate_Hz) noexcept;
+  /// `period_ns`: the control period; `ns_per_count`: of the execution clock that times the
+  /// stages.
+  Telemetry(uint8_t node_id, uint32_t period_ns, int rate_Hz, float ns_per_count = 1.0f) noexcept;
 
   /// Sets the fast-telemetry rate; false (unchanged) outside 10..1000 Hz.
   bool set_rate_Hz(int rate_Hz) noexcept;
@@ -61,9 +62,11 @@ class Telemetry {
   void send_heartbeat(hal::CanBus& can, const DriveStatus& status,
                       const StateMachine& machine) noexcept;
   uint32_t time_ms(uint64_t tick) const noexcept;
+  void send_stage_timing(hal::CanBus& can, const StageCounts& counts) noexcept;
 
   uint8_t node_id_;
   uint32_t period_ns_;
+  float us_per_count_;
   uint64_t ticks_per_10Hz_;
   uint64_t fast_period_ticks_ = 1;
   // The ticks at which the cyclic frames are due next (heartbeat at 0, the timing frame

@@ -34,6 +34,8 @@ enum class MessageId : uint8_t {
   telemetry_current = 0x11,
   telemetry_voltage = 0x12,
   timing = 0x13,
+  stage_timing_1 = 0x14,
+  stage_timing_2 = 0x15,
 };
 
 enum class Direction : uint8_t {
@@ -185,6 +187,21 @@ inline constexpr Signal kTimingSignals[] = {
     {"budget_us", 48, 16, false, 1, 100, 0.0f, "us", "tick budget (0: not checked)"},
 };
 
+// Each stage of one tick (firmware/stages/stage_clock.hpp), from the last tick whose stages
+// were timed.
+inline constexpr Signal kStageTiming1Signals[] = {
+    {"sense_us", 0, 16, false, 1, 100, 0.0f, "us", "sense stage: ADC and encoder"},
+    {"estimate_us", 16, 16, false, 1, 100, 0.0f, "us", "estimate stage: observers, prediction"},
+    {"supervise_us", 32, 16, false, 1, 100, 0.0f, "us", "supervise stage: commands, states"},
+    {"law_us", 48, 16, false, 1, 100, 0.0f, "us", "law stage: magnetizing or control law"},
+};
+inline constexpr Signal kStageTiming2Signals[] = {
+    {"modulate_us", 0, 16, false, 1, 100, 0.0f, "us", "modulate stage: limits, SVPWM"},
+    {"protect_us", 16, 16, false, 1, 100, 0.0f, "us", "protect stage: every trip decision"},
+    {"actuate_us", 32, 16, false, 1, 100, 0.0f, "us", "actuate stage: PWM write, observers"},
+    {"publish_us", 48, 16, false, 1, 100, 0.0f, "us", "publish stage of the tick before"},
+};
+
 inline constexpr Message kMessages[] = {
     {MessageId::emergency_stop, "emergency_stop", 2, Direction::host_to_drive, Timing::on_event, 0,
      "PWM off at once, latched as a fault", kEmptyCommandSignals},
@@ -218,6 +235,10 @@ inline constexpr Message kMessages[] = {
      Timing::configurable, 10, "fast telemetry 3/3, sent last", kVoltageSignals},
     {MessageId::timing, "timing", 8, Direction::drive_to_host, Timing::cyclic, 100,
      "tick execution time at 10 Hz", kTimingSignals},
+    {MessageId::stage_timing_1, "stage_timing_1", 8, Direction::drive_to_host, Timing::cyclic,
+     100, "execution time of the tick's first four stages at 10 Hz", kStageTiming1Signals},
+    {MessageId::stage_timing_2, "stage_timing_2", 8, Direction::drive_to_host, Timing::cyclic,
+     100, "execution time of the tick's last four stages at 10 Hz", kStageTiming2Signals},
 };
 
 /// The definition of a message id, or nullptr.
