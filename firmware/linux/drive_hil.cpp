@@ -33,7 +33,7 @@
 #include "firmware/linux/hil_report.hpp"
 #include "firmware/linux/hil_tick.hpp"
 #include "firmware/protocol/messages.hpp"
-#include "firmware/sim/scenario_config.hpp"
+#include "hal_sim/drive/scenario_config.hpp"
 #include "hal/linux/gpiod_lines.hpp"
 #include "hal/linux/queued_can_bus.hpp"
 #include "hal/linux/realtime_timer.hpp"
@@ -110,7 +110,7 @@ int run(const Options& o, const imd::sim::Scenario& s, imd::hal::QueuedCanBus* c
         imd::hal::GpiodLines* gpio, const Lines& lines, const sigset_t& signals,
         std::vector<std::string> warnings) {
   using namespace imd;
-  firmware::DriveConfig config = firmware::drive_config(s);
+  firmware::DriveConfig config = sim::drive_config(s);
   config.node_id = static_cast<uint8_t>(o.node);
   config.commands_over_can = can != nullptr;
   config.auto_enable = can == nullptr;
@@ -124,14 +124,14 @@ int run(const Options& o, const imd::sim::Scenario& s, imd::hal::QueuedCanBus* c
   config.fault_output_line = lines.fault;
   config.timing_output_line = lines.timing;
 
-  sim::SimBoard board(s.motor, firmware::board_config(s));
-  firmware::prepare_board(board, s);
+  sim::SimBoard board(s.motor, sim::board_config(s));
+  sim::prepare_board(board, s);
   hal::RealtimeOptions timing;
   timing.period_ns = static_cast<uint32_t>(std::lround(s.sample_period_s * 1e9));
   timing.fifo_priority = o.priority;
   timing.cpu = o.cpu;
   hal::RealtimeTimer timer(timing);
-  const firmware::ScenarioReferences<T> references(s);
+  const sim::ScenarioReferences<T> references(s);
   sim::SimulatedDrive<T> simulated(board, s.motor, config,
                                    {s.ideal_sensors, s.inner_feedback, s.current_fed},
                                    &references, timer, can, gpio);

@@ -9,7 +9,7 @@
 #include "firmware/drive_state.hpp"
 #include "hal_sim/scenario.hpp"
 #include "test_motors.hpp"
-#include "tools/drive_sim/scenario_run.hpp"
+#include "hal_sim/drive/scenario_run.hpp"
 
 namespace imd::sim {
 namespace {

@@ -8,7 +8,7 @@
 #include "control/voltage_fed_model.hpp"
 #include "hal_sim/scenario.hpp"
 #include "test_motors.hpp"
-#include "tools/drive_sim/scenario_run.hpp"
+#include "hal_sim/drive/scenario_run.hpp"
 
 namespace imd::sim {
 namespace {

@@ -7,7 +7,7 @@
 #include "firmware/drive.hpp"
 #include "hal_sim/scenario.hpp"
 #include "hal_sim/sim_board.hpp"
-#include "tools/drive_sim/scenario_run.hpp"
+#include "hal_sim/drive/scenario_run.hpp"
 
 namespace {
 

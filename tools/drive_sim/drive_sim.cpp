@@ -29,8 +29,8 @@ extern char** environ;
 #include "hal_sim/config_error.hpp"
 #include "hal_sim/scenario.hpp"
 #include "tools/can_log/candump_log.hpp"
-#include "tools/drive_sim/scenario_run.hpp"
-#include "tools/drive_sim/scripted_commands.hpp"
+#include "hal_sim/drive/scenario_run.hpp"
+#include "hal_sim/drive/scripted_commands.hpp"
 
 namespace {
 

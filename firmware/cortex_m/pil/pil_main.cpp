@@ -12,9 +12,9 @@
 #include "firmware/cortex_m/pil/mps2_an386.hpp"
 #include "firmware/cortex_m/pil/pil_report.hpp"
 #include "firmware/drive.hpp"
-#include "firmware/sim/embedded_scenario.hpp"
-#include "firmware/sim/lookahead_references.hpp"
-#include "firmware/sim/run_metrics.hpp"
+#include "hal_sim/drive/embedded_scenario.hpp"
+#include "hal_sim/drive/lookahead_references.hpp"
+#include "hal_sim/run_metrics.hpp"
 #include "hal/cortex_m/armv7m.hpp"
 #include "hal/cortex_m/cmsdk_uart.hpp"
 #include "hal/cortex_m/fault_handler.hpp"
@@ -25,7 +25,7 @@
 
 namespace imd::firmware {
 
-extern const EmbeddedScenario kSeed000Realistic;
+extern const sim::EmbeddedScenario kSeed000Realistic;
 
 namespace {
 
@@ -56,11 +56,11 @@ void wait_for_tick(const cm::TwoStageTick& timer) noexcept {
   cm::enable_interrupts();
 }
 
-int run(const EmbeddedScenario& s, cm::CmsdkUart& console) {
+int run(const sim::EmbeddedScenario& s, cm::CmsdkUart& console) {
   static sim::SimBoard board(s.motor, s.board);
   board.set_load_profile(s.load);
   board.plant().set_state(s.initial_state);
-  static LookaheadReferences<float> references(s.references, s.drive.sample_period_s);
+  static sim::LookaheadReferences<float> references(s.references, s.drive.sample_period_s);
   static SimulatedSensors sensors(board);
   static cm::TwoStageTick timer(
       {mps2::kCoreClock_Hz, static_cast<uint32_t>(s.board.period_s * 1e9 + 0.5), true}, sensors);
@@ -68,7 +68,7 @@ int run(const EmbeddedScenario& s, cm::CmsdkUart& console) {
   static sim::SimulatedDrive<float> simulated(board, s.motor, s.drive, {}, &references, timer,
                                               &board.can());
   Drive<float>& drive = simulated.drive();
-  RunMetrics metrics(s.settle_s);
+  sim::RunMetrics metrics(s.settle_s);
   PilReport report(console);
   report.start(s, timer.counts_per_period());  // with the stack used so far: the start-up's
 

@@ -7,10 +7,10 @@ namespace imd::firmware {
 
 using hal::cortex_m::TextLine;
 
-MetricsSample tracking_sample(const EmbeddedScenario& s, const sim::PlantState& truth,
+sim::MetricsSample tracking_sample(const sim::EmbeddedScenario& s, const sim::PlantState& truth,
                               double load_Nm, const TickRecord<float>& record,
                               double t_s) noexcept {
-  MetricsSample m;
+  sim::MetricsSample m;
   m.t_s = t_s;
   m.speed_err_rad_s = truth.omega_mech_rad_s - s.references.speed.at(t_s);
   // |Phi|^2 is the same in every frame: no rotation into the rotor frame needed.
@@ -21,7 +21,7 @@ MetricsSample tracking_sample(const EmbeddedScenario& s, const sim::PlantState& 
   return m;
 }
 
-void PilReport::start(const EmbeddedScenario& s, uint32_t counts_per_period) noexcept {
+void PilReport::start(const sim::EmbeddedScenario& s, uint32_t counts_per_period) noexcept {
   TextLine line;
   line << "pil start scenario " << s.name << " duration_s ";
   line.scientific(s.duration_s, 4) << " counts_per_period " << uint64_t(counts_per_period)
@@ -50,7 +50,7 @@ void PilReport::metric(const char* name, double value) noexcept {
 }
 
 int PilReport::finish(const Drive<float>& drive, const hal::cortex_m::TwoStageTick& timer,
-                      const RunMetrics& metrics, double running_from_s,
+                      const sim::RunMetrics& metrics, double running_from_s,
                       uint64_t frames_sent) noexcept {
   metric("speed_rms_err_rad_s", metrics.speed_rms_err_rad_s());
   metric("speed_max_err_rad_s", metrics.speed_max_err_rad_s());

@@ -1,13 +1,13 @@
 #pragma once
 /// What the processor-in-the-loop run measures and prints: the tracking errors of each tick
-/// against the plant (the same metrics as drive_sim, firmware/sim/run_metrics.hpp) and, at the
+/// against the plant (the same metrics as drive_sim, hal_sim/run_metrics.hpp) and, at the
 /// end, the summary on the console, one "pil <kind> <name> <value>" line per figure, which
 /// tests/qemu/pil_test.py parses.
 #include <cstdint>
 
 #include "firmware/drive.hpp"
-#include "firmware/sim/embedded_scenario.hpp"
-#include "firmware/sim/run_metrics.hpp"
+#include "hal_sim/drive/embedded_scenario.hpp"
+#include "hal_sim/run_metrics.hpp"
 #include "hal/cortex_m/cmsdk_uart.hpp"
 #include "hal/cortex_m/two_stage_tick.hpp"
 #include "hal_sim/induction_motor_plant.hpp"
@@ -16,7 +16,7 @@ namespace imd::firmware {
 
 /// Tick k's errors: `truth` and `load_Nm` at t_k, before the tick; `record` the tick's. The
 /// DSMC's metrics: the speed against the profile, the rotor flux against its reference.
-MetricsSample tracking_sample(const EmbeddedScenario& s, const sim::PlantState& truth,
+sim::MetricsSample tracking_sample(const sim::EmbeddedScenario& s, const sim::PlantState& truth,
                               double load_Nm, const TickRecord<float>& record, double t_s) noexcept;
 
 /// Stage durations summed over the run, in execution-clock counts (firmware/stages/stage_clock.hpp).
@@ -33,12 +33,12 @@ class PilReport {
  public:
   explicit PilReport(hal::cortex_m::CmsdkUart& console) noexcept : console_(console) {}
 
-  void start(const EmbeddedScenario& s, uint32_t counts_per_period) noexcept;
+  void start(const sim::EmbeddedScenario& s, uint32_t counts_per_period) noexcept;
   /// Prints each stage's mean counts per tick.
   void stages(const StageTotals& totals, uint32_t clock_Hz) noexcept;
   /// Prints the summary; returns the exit status (0: no fault, no overrun, metrics measured).
   int finish(const Drive<float>& drive, const hal::cortex_m::TwoStageTick& timer,
-             const RunMetrics& metrics, double running_from_s, uint64_t frames_sent) noexcept;
+             const sim::RunMetrics& metrics, double running_from_s, uint64_t frames_sent) noexcept;
 
  private:
   void metric(const char* name, double value) noexcept;

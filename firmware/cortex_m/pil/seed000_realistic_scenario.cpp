@@ -2,13 +2,13 @@
 // The unit test scenario_embed_up_to_date regenerates it and fails when it differs.
 #include <limits>
 
-#include "firmware/sim/embedded_scenario.hpp"
+#include "hal_sim/drive/embedded_scenario.hpp"
 
 namespace imd::firmware {
 
-extern const EmbeddedScenario kSeed000Realistic;
-const EmbeddedScenario kSeed000Realistic = [] {
-  EmbeddedScenario s;
+extern const sim::EmbeddedScenario kSeed000Realistic;
+const sim::EmbeddedScenario kSeed000Realistic = [] {
+  sim::EmbeddedScenario s;
   s.name = "seed000_realistic";
   s.motor.Rs_Ohm = 14;
   s.motor.Ls_H = 0.40000000000000002;

@@ -6,35 +6,35 @@
 
 #include "firmware/drive_config.hpp"
 #include "firmware/reference_source.hpp"
-#include "firmware/sim/scenario_profiles.hpp"
+#include "hal_sim/drive/scenario_profiles.hpp"
 #include "hal_sim/scenario.hpp"
 #include "hal_sim/sim_board.hpp"
 
-namespace imd::firmware {
+namespace imd::sim {
 
 /// The board: period, integration, latency, sensors, bus.
-sim::SimBoardConfig board_config(const sim::Scenario& s);
+SimBoardConfig board_config(const Scenario& s);
 
 /// The scenario's load profile and initial plant state: at rest at initial_theta, magnetized
 /// (Phi = Lm I, along A) if initial_flux2 > 0.
-void prepare_board(sim::SimBoard& board, const sim::Scenario& s);
+void prepare_board(SimBoard& board, const Scenario& s);
 
 /// The drive: controller, limits, commands, and protection (defaults from the board, then the
 /// scenario's [protection] table). In lock-step simulation the tick budget is checked only when
 /// the scenario sets one (the host's wall-clock time per tick is not the MCU's).
-DriveConfig drive_config(const sim::Scenario& s);
+firmware::DriveConfig drive_config(const Scenario& s);
 
 /// The scenario's speed, flux and torque profiles.
-ScenarioProfiles profiles(const sim::Scenario& s);
+ScenarioProfiles profiles(const Scenario& s);
 
 /// The scenario's profiles as the reference source of a drive of arithmetic T: evaluated in
 /// double at each tick's time, then rounded to T.
 template <typename T>
-class ScenarioReferences final : public ReferenceSource<T> {
+class ScenarioReferences final : public firmware::ReferenceSource<T> {
  public:
-  explicit ScenarioReferences(const sim::Scenario& s)
+  explicit ScenarioReferences(const Scenario& s)
       : profiles_(profiles(s)), period_s_(s.sample_period_s) {}
-  Reference<T> at_tick(uint64_t k) const noexcept override {
+  firmware::Reference<T> at_tick(uint64_t k) const noexcept override {
     return reference_at_tick<T>(profiles_, period_s_, k);
   }
 
@@ -43,4 +43,4 @@ class ScenarioReferences final : public ReferenceSource<T> {
   double period_s_;
 };
 
-}  // namespace imd::firmware
+}  // namespace imd::sim

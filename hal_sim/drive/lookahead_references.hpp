@@ -8,12 +8,12 @@
 #include <cstdint>
 
 #include "firmware/reference_source.hpp"
-#include "firmware/sim/scenario_profiles.hpp"
+#include "hal_sim/drive/scenario_profiles.hpp"
 
-namespace imd::firmware {
+namespace imd::sim {
 
 template <typename T>
-class LookaheadReferences final : public ReferenceSource<T> {
+class LookaheadReferences final : public firmware::ReferenceSource<T> {
  public:
   static constexpr uint64_t kDepth = 32;
 
@@ -27,13 +27,13 @@ class LookaheadReferences final : public ReferenceSource<T> {
     }
   }
   /// Tick context: a read of the ring.
-  Reference<T> at_tick(uint64_t k) const noexcept override { return ring_[k % kDepth]; }
+  firmware::Reference<T> at_tick(uint64_t k) const noexcept override { return ring_[k % kDepth]; }
 
  private:
   const ScenarioProfiles& profiles_;
   double period_s_;
   uint64_t next_ = 0;
-  std::array<Reference<T>, kDepth> ring_{};
+  std::array<firmware::Reference<T>, kDepth> ring_{};
 };
 
-}  // namespace imd::firmware
+}  // namespace imd::sim

@@ -8,7 +8,7 @@
 #include <cstdint>
 #include <limits>
 
-namespace imd::firmware {
+namespace imd::sim {
 
 /// One tick's errors against the plant's true state.
 struct MetricsSample {
@@ -59,4 +59,4 @@ class RunMetrics {
   uint64_t saturated_ = 0, measured_ = 0;
 };
 
-}  // namespace imd::firmware
+}  // namespace imd::sim

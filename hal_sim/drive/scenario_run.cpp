@@ -1,4 +1,4 @@
-#include "tools/drive_sim/scenario_run.hpp"
+#include "hal_sim/drive/scenario_run.hpp"
 
 #include <bit>
 #include <chrono>
@@ -8,22 +8,22 @@
 #include "control/current_fed_model.hpp"
 #include "control/frames.hpp"
 #include "firmware/drive.hpp"
-#include "firmware/sim/run_metrics.hpp"
-#include "firmware/sim/scenario_config.hpp"
+#include "hal_sim/run_metrics.hpp"
+#include "hal_sim/drive/scenario_config.hpp"
 #include "hal_sim/drive/simulated_drive.hpp"
 #include "hal_sim/sim_board.hpp"
 #include "hal_sim/sim_can_host.hpp"
-#include "tools/drive_sim/scripted_commands.hpp"
+#include "hal_sim/drive/scripted_commands.hpp"
 
 namespace imd::sim {
 namespace {
 
 template <typename T>
 Summary run(const Scenario& s, const RunCallbacks& callbacks) {
-  SimBoard board(s.motor, firmware::board_config(s));
-  firmware::prepare_board(board, s);
-  const firmware::ScenarioReferences<T> references(s);
-  SimulatedDrive<T> simulated(board, s.motor, firmware::drive_config(s),
+  SimBoard board(s.motor, sim::board_config(s));
+  sim::prepare_board(board, s);
+  const sim::ScenarioReferences<T> references(s);
+  SimulatedDrive<T> simulated(board, s.motor, sim::drive_config(s),
                               {s.ideal_sensors, s.inner_feedback, s.current_fed}, &references,
                               board.timer(), &board.can());
   firmware::Drive<T>& drive = simulated.drive();
@@ -38,7 +38,7 @@ Summary run(const Scenario& s, const RunCallbacks& callbacks) {
   auto last_progress = wall_start;
   const auto ticks = static_cast<uint64_t>(std::llround(s.duration_s / s.sample_period_s));
   const control::MotorParameters& m = s.motor;
-  firmware::RunMetrics metrics(s.settle_s);
+  sim::RunMetrics metrics(s.settle_s);
   double torque_sq = 0;
   uint64_t torque_count = 0;
   double hold_sq = 0;

@@ -1,14 +1,14 @@
-#include "firmware/sim/scenario_config.hpp"
+#include "hal_sim/drive/scenario_config.hpp"
 
 #include <algorithm>
 #include <cmath>
 
 #include "control/frames.hpp"
 
-namespace imd::firmware {
+namespace imd::sim {
 
-sim::SimBoardConfig board_config(const sim::Scenario& s) {
-  sim::SimBoardConfig c;
+SimBoardConfig board_config(const Scenario& s) {
+  SimBoardConfig c;
   c.period_s = s.sample_period_s;
   c.substeps = s.substeps;
   c.pwm_latency_ticks = s.pwm_latency_ticks;
@@ -21,11 +21,11 @@ sim::SimBoardConfig board_config(const sim::Scenario& s) {
   return c;
 }
 
-DriveConfig drive_config(const sim::Scenario& s) {
-  DriveConfig c;
+firmware::DriveConfig drive_config(const Scenario& s) {
+  firmware::DriveConfig c;
   c.sample_period_s = s.sample_period_s;
   c.controller =
-      s.controller == "iol" ? ControllerKind::iol : ControllerKind::dsmc;
+      s.controller == "iol" ? firmware::ControllerKind::iol : firmware::ControllerKind::dsmc;
   c.iol_period_s = s.iol_period_s;
   // The ideal current source imposes the current at once; the deadbeat loop a tick later.
   c.current_response_ticks = s.current_fed ? 0 : 1;
@@ -52,8 +52,8 @@ DriveConfig drive_config(const sim::Scenario& s) {
   c.stator_flux2_ref_Wb2 = s.stator_flux2_Wb2;
   c.max_flux2_Wb2 = 2.0 * std::max(s.flux2_Wb2, s.stator_flux2_Wb2);
   // Protection: defaults from the scenario's board, then its [protection] table.
-  ProtectionConfig& p = c.protection;
-  const sim::ProtectionSettings& set = s.protection;
+  firmware::ProtectionConfig& p = c.protection;
+  const ProtectionSettings& set = s.protection;
   p.overcurrent_A = set.overcurrent_A.value_or(1.5 * s.i_max_A);
   p.bus_min_V = set.bus_min_V.value_or(0.7 * s.v_bus_V);  // +-30 % of the nominal bus
   p.bus_max_V = set.bus_max_V.value_or(1.3 * s.v_bus_V);
@@ -77,20 +77,20 @@ DriveConfig drive_config(const sim::Scenario& s) {
   return c;
 }
 
-void prepare_board(sim::SimBoard& board, const sim::Scenario& s) {
+void prepare_board(SimBoard& board, const Scenario& s) {
   board.set_load_profile(s.load);
-  sim::PlantState start;
+  PlantState start;
   start.theta_mech_rad = s.initial_theta_mech_rad;
   const auto rotor =
       control::Rotation<double>::from_angle(s.motor.pole_pairs * s.initial_theta_mech_rad);
   const double flux_Wb = std::sqrt(s.initial_flux2_Wb2);
-  start.flux_r_alphabeta_Wb = rotor.apply(sim::Vec2(flux_Wb, 0.0));
-  start.i_s_alphabeta_A = rotor.apply(sim::Vec2(flux_Wb / s.motor.Lm_H, 0.0));
+  start.flux_r_alphabeta_Wb = rotor.apply(Vec2(flux_Wb, 0.0));
+  start.i_s_alphabeta_A = rotor.apply(Vec2(flux_Wb / s.motor.Lm_H, 0.0));
   board.plant().set_state(start);
 }
 
-ScenarioProfiles profiles(const sim::Scenario& s) {
+ScenarioProfiles profiles(const Scenario& s) {
   return {s.speed, s.flux2_Wb2, s.torque, s.stator_flux2_Wb2};
 }
 
-}  // namespace imd::firmware
+}  // namespace imd::sim

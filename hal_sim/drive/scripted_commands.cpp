@@ -1,4 +1,4 @@
-#include "tools/drive_sim/scripted_commands.hpp"
+#include "hal_sim/drive/scripted_commands.hpp"
 
 #include <fmt/format.h>
 
