@@ -82,6 +82,8 @@ class SimBoard {
   /// end_period() integrates [t_k, t_{k+1}]. The board's own timer() is not used then.
   void begin_period();
   void end_period();
+  /// Between the two halves: the board's own timer runs the firmware's tick.
+  void fire_timer() noexcept { timer_.fire(); }
 
   /// Applies a fault at once (FaultKind documents each); it lasts to the end of the run. Call
   /// between ticks: the next run_tick() sees it. Returns false and changes nothing when a

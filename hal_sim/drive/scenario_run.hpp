@@ -9,36 +9,10 @@
 #include <vector>
 
 #include "hal/can_bus.hpp"
+#include "hal_sim/drive/tick_observer.hpp"
 #include "hal_sim/scenario.hpp"
 
 namespace imd::sim {
-
-/// One row per tick: the plant's true state at t_k, and what the drive estimated and commanded.
-struct SimRow {
-  double t_s = 0.0;
-  double omega_mech_rad_s = 0.0, omega_ref_rad_s = 0.0, omega_est_rad_s = 0.0;
-  double flux2_Wb2 = 0.0, flux2_ref_Wb2 = 0.0, flux2_est_Wb2 = 0.0;
-  double load_Nm = 0.0, load_est_Nm = 0.0;
-  double i_alpha_A = 0.0, i_beta_A = 0.0;
-  double v_alpha_V = 0.0, v_beta_V = 0.0;  ///< voltage the plant saw over [t_k, t_{k+1}]
-  double discriminant = 0.0, c_k = 0.0;
-  double flux_A_Wb = 0.0, flux_B_Wb = 0.0, flux_A_est_Wb = 0.0, flux_B_est_Wb = 0.0;
-  double theta_mech_rad = 0.0, theta_est_rad = 0.0;
-  double torque_Nm = 0.0;  ///< at the start of the period, with its current
-  // The current-fed controller (iol): at T0 boundaries (iol_boundary), else held.
-  double torque_ref_Nm = 0.0, y2 = 0.0, y2_ref = 0.0, stator_flux2_Wb2 = 0.0;
-  double stator_flux2_ref_Wb2 = 0.0;
-  double i_hold_err_A = 0.0;  ///< |i_AB - i_cmd|: departure from the zero-order hold (iol)
-  // What the drive's telemetry carries (the CAN round trip compares against these).
-  double omega_ref_cmd_rad_s = 0.0;  ///< the speed reference the law aimed at (after the ramp)
-  double flux2_ctrl_est_Wb2 = 0.0, flux2_ctrl_ref_Wb2 = 0.0;  ///< the controlled flux
-  double iA_est_A = 0.0, iB_est_A = 0.0;  ///< estimated stator current, rotor frame
-  double v_bus_meas_V = 0.0;
-  double u_alpha_cmd_V = 0.0, u_beta_cmd_V = 0.0;  ///< stator voltage command
-  bool iol_boundary = false;
-  int state = 0;
-  bool saturated = false;
-};
 
 /// A fault the drive latched (or the plant diverging). Times are tick times; NaN when it did
 /// not happen (a fault that was not injected, a PWM that stayed on).
@@ -63,6 +37,8 @@ struct Summary {
   uint64_t ticks = 0;
   double simulated_s = 0.0, wall_time_s = 0.0;
   double tick_exec_ns_mean = 0.0, tick_exec_ns_max = 0.0;
+  /// Each stage's mean execution time (firmware::kStageNames order), over the timed ticks.
+  double stage_ns_mean[firmware::kStageCount] = {};
   double running_from_s = -1.0;  ///< first time the drive was running (-1: never)
   std::vector<FaultEvent> faults;
 };

@@ -102,6 +102,10 @@ nlohmann::ordered_json summary_json(const imd::sim::Scenario& s, const imd::sim:
                       {"detected_at_s", time(f.detected_at_s)},
                       {"pwm_off_at_s", time(f.pwm_off_at_s)}});
   }
+  nlohmann::ordered_json stages;  // host wall-clock time: for comparison, not the MCU's
+  for (int i = 0; i < imd::firmware::kStageCount; ++i) {
+    stages[imd::firmware::kStageNames[i]] = r.stage_ns_mean[i];
+  }
   return {{"scenario", s.source},
           {"precision", s.precision},
           {"settle_s", s.settle_s},
@@ -124,6 +128,7 @@ nlohmann::ordered_json summary_json(const imd::sim::Scenario& s, const imd::sim:
           {"simulated_s_per_wall_s", r.wall_time_s > 0 ? r.simulated_s / r.wall_time_s : 0.0},
           {"tick_exec_ns_mean", r.tick_exec_ns_mean},
           {"tick_exec_ns_max", r.tick_exec_ns_max},
+          {"stage_ns", stages},
           {"faults", faults}};
 }
 

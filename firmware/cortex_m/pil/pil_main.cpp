@@ -7,6 +7,7 @@
 /// The scenario is compiled in (seed000_realistic_scenario.cpp). At the end the summary goes
 /// to the UART and the run ends through semihosting with the exit status:
 ///   0 the run completed with no fault and no overrun, 1 it did not, 3 a processor fault.
+#include <cmath>
 #include <cstdint>
 
 #include "firmware/cortex_m/pil/mps2_an386.hpp"
@@ -14,12 +15,12 @@
 #include "firmware/drive.hpp"
 #include "hal_sim/drive/embedded_scenario.hpp"
 #include "hal_sim/drive/lookahead_references.hpp"
-#include "hal_sim/run_metrics.hpp"
 #include "hal/cortex_m/armv7m.hpp"
 #include "hal/cortex_m/cmsdk_uart.hpp"
 #include "hal/cortex_m/fault_handler.hpp"
 #include "hal/cortex_m/semihosting.hpp"
 #include "hal/cortex_m/two_stage_tick.hpp"
+#include "hal_sim/drive/lockstep_period.hpp"
 #include "hal_sim/drive/simulated_drive.hpp"
 #include "hal_sim/sim_board.hpp"
 
@@ -68,38 +69,36 @@ int run(const sim::EmbeddedScenario& s, cm::CmsdkUart& console) {
   static sim::SimulatedDrive<float> simulated(board, s.motor, s.drive, {}, &references, timer,
                                               &board.can());
   Drive<float>& drive = simulated.drive();
-  sim::RunMetrics metrics(s.settle_s);
+  // The same rows and metrics as drive_sim's (hal_sim/drive/tick_observer.hpp).
+  static sim::TickObserver<float> observer(
+      sim::observed_run(s.references, s.settle_s, s.motor, s.drive));
   PilReport report(console);
   report.start(s, timer.counts_per_period());  // with the stack used so far: the start-up's
 
   const auto ticks = static_cast<uint64_t>(s.duration_s / s.board.period_s + 0.5);
   uint64_t frames_sent = 0;
-  StageTotals stage_totals;
-  double running_from_s = -1.0;
+  sim::StageTotals stage_totals;
   hal::CanFrame frame;
   references.fill_from(0);
   cm::bind_tick_interrupts(timer);
   timer.start(drive);
   for (uint64_t k = 0; k < ticks; ++k) {
     const double t_s = double(k) * s.board.period_s;
-    const sim::PlantState truth = board.plant().state();  // at t_k, before the tick
-    const double load_Nm = board.load_Nm();
-    if (k > 0) timer.resume();
-    wait_for_tick(timer);
-
-    // Time stands still: the tick's results, then the plant over [t_k, t_k+1].
+    // The tick runs from the timer's interrupts; then time stands still while the plant
+    // advances over [t_k, t_k+1] and the row is observed.
+    const sim::SimRow& row = sim::lockstep_period(board, drive, observer, t_s, [&] {
+      if (k > 0) timer.resume();
+      wait_for_tick(timer);
+    });
     const TickRecord<float>& rec = drive.record();
     while (board.can_side().take_sent(frame)) ++frames_sent;  // the host side reads the bus
-    if (running_from_s < 0 && rec.state == DriveState::running) running_from_s = t_s;
     if (rec.stages_timed) stage_totals.add(rec.stage_counts);
-    metrics.add(tracking_sample(s, truth, load_Nm, rec, t_s));
-    board.end_period();
     references.fill_from(k + 1);
-    if (!truth.i_s_alphabeta_A.allFinite()) break;
+    if (!std::isfinite(row.i_alpha_A) || !std::isfinite(row.i_beta_A)) break;
   }
   timer.stop();
   report.stages(stage_totals, timer.execution_clock_Hz());
-  return report.finish(drive, timer, metrics, running_from_s, frames_sent);
+  return report.finish(drive, timer, observer, frames_sent);
 }
 
 }  // namespace

@@ -7,20 +7,6 @@ namespace imd::firmware {
 
 using hal::cortex_m::TextLine;
 
-sim::MetricsSample tracking_sample(const sim::EmbeddedScenario& s, const sim::PlantState& truth,
-                              double load_Nm, const TickRecord<float>& record,
-                              double t_s) noexcept {
-  sim::MetricsSample m;
-  m.t_s = t_s;
-  m.speed_err_rad_s = truth.omega_mech_rad_s - s.references.speed.at(t_s);
-  // |Phi|^2 is the same in every frame: no rotation into the rotor frame needed.
-  m.flux2_err_Wb2 = truth.flux_r_alphabeta_Wb.squaredNorm() - s.references.flux2_Wb2;
-  m.load_err_Nm = double(record.load_est_Nm) - load_Nm;
-  m.current_A = truth.i_s_alphabeta_A.norm();
-  m.saturated = record.law.speed_saturated || record.law.flux_saturated || record.voltage_clipped;
-  return m;
-}
-
 void PilReport::start(const sim::EmbeddedScenario& s, uint32_t counts_per_period) noexcept {
   TextLine line;
   line << "pil start scenario " << s.name << " duration_s ";
@@ -30,14 +16,14 @@ void PilReport::start(const sim::EmbeddedScenario& s, uint32_t counts_per_period
   console_.write(line.view());
 }
 
-void PilReport::stages(const StageTotals& totals, uint32_t clock_Hz) noexcept {
+void PilReport::stages(const sim::StageTotals& totals, uint32_t clock_Hz) noexcept {
   // Mean counts per tick of each stage, one line each; under QEMU -icount shift=0 with a
   // 25 MHz SysTick one count is 40 instructions.
   for (int i = 0; i < kStageCount; ++i) {
     TextLine line;
-    line << "pil stage " << kStageNames[i] << " clock_Hz " << uint64_t(clock_Hz) << " mean_counts ";
+    line << "pil stage_" << kStageNames[i] << " mean_counts ";
     line.scientific(totals.ticks ? double(totals.counts[i]) / double(totals.ticks) : 0.0, 5);
-    line << "\n";
+    line << " clock_Hz " << uint64_t(clock_Hz) << " timed_ticks " << totals.ticks << "\n";
     console_.write(line.view());
   }
 }
@@ -50,17 +36,19 @@ void PilReport::metric(const char* name, double value) noexcept {
 }
 
 int PilReport::finish(const Drive<float>& drive, const hal::cortex_m::TwoStageTick& timer,
-                      const sim::RunMetrics& metrics, double running_from_s,
-                      uint64_t frames_sent) noexcept {
-  metric("speed_rms_err_rad_s", metrics.speed_rms_err_rad_s());
-  metric("speed_max_err_rad_s", metrics.speed_max_err_rad_s());
+                      const sim::TickObserver<float>& observer, uint64_t frames_sent) noexcept {
+  const sim::RunMetrics& metrics = observer.metrics();
+  metric("speed_rms_err_rad_s", observer.speed_rms_err_rad_s());
+  metric("speed_max_err_rad_s", observer.speed_max_err_rad_s());
   metric("flux2_rms_err_Wb2", metrics.flux2_rms_err_Wb2());
   metric("flux2_max_err_Wb2", metrics.flux2_max_err_Wb2());
   metric("load_est_rms_err_Nm", metrics.load_est_rms_err_Nm());
   metric("i_peak_A", metrics.i_peak_A());
   metric("i_peak_total_A", metrics.i_peak_total_A());
   metric("saturated_fraction", metrics.saturated_fraction());
-  metric("running_from_s", running_from_s);
+  metric("torque_rms_err_Nm", observer.torque_rms_err_Nm());
+  metric("i_hold_rms_err_A", observer.i_hold_rms_err_A());
+  metric("running_from_s", observer.running_from_s());
 
   const ExecutionStats& exec = drive.execution();
   TextLine line;

@@ -7,27 +7,13 @@
 
 #include "firmware/drive.hpp"
 #include "hal_sim/drive/embedded_scenario.hpp"
-#include "hal_sim/run_metrics.hpp"
+#include "hal_sim/drive/stage_totals.hpp"
+#include "hal_sim/drive/tick_observer.hpp"
 #include "hal/cortex_m/cmsdk_uart.hpp"
 #include "hal/cortex_m/two_stage_tick.hpp"
 #include "hal_sim/induction_motor_plant.hpp"
 
 namespace imd::firmware {
-
-/// Tick k's errors: `truth` and `load_Nm` at t_k, before the tick; `record` the tick's. The
-/// DSMC's metrics: the speed against the profile, the rotor flux against its reference.
-sim::MetricsSample tracking_sample(const sim::EmbeddedScenario& s, const sim::PlantState& truth,
-                              double load_Nm, const TickRecord<float>& record, double t_s) noexcept;
-
-/// Stage durations summed over the run, in execution-clock counts (firmware/stages/stage_clock.hpp).
-struct StageTotals {
-  uint64_t counts[kStageCount] = {};
-  uint64_t ticks = 0;
-  void add(const StageCounts& c) noexcept {
-    for (int i = 0; i < kStageCount; ++i) counts[i] += c[i];
-    ++ticks;
-  }
-};
 
 class PilReport {
  public:
@@ -35,10 +21,10 @@ class PilReport {
 
   void start(const sim::EmbeddedScenario& s, uint32_t counts_per_period) noexcept;
   /// Prints each stage's mean counts per tick.
-  void stages(const StageTotals& totals, uint32_t clock_Hz) noexcept;
+  void stages(const sim::StageTotals& totals, uint32_t clock_Hz) noexcept;
   /// Prints the summary; returns the exit status (0: no fault, no overrun, metrics measured).
   int finish(const Drive<float>& drive, const hal::cortex_m::TwoStageTick& timer,
-             const sim::RunMetrics& metrics, double running_from_s, uint64_t frames_sent) noexcept;
+             const sim::TickObserver<float>& observer, uint64_t frames_sent) noexcept;
 
  private:
   void metric(const char* name, double value) noexcept;
