@@ -7,7 +7,7 @@
 /// The float version: Cody-Waite reduction by pi/2 with pi/2 split in three parts whose
 /// products with the quadrant number are exact for |n| < 2^12, then Cephes' sinf/cosf
 /// polynomials on [-pi/4, pi/4] (relative error below 1e-7 there). The result is within 2 ulp
-/// of 1 of the exact values for |angle| <= 4096 rad (tests/unit/test_sin_cos.cpp); beyond that,
+/// of 1 of the exact values for |angle| <= 4096 rad (tests/control/test_sin_cos.cpp); beyond that,
 /// and for a non-finite angle, it is the standard library's.
 #include <cmath>
 #include <cstdint>

@@ -1,13 +1,7 @@
 # The host CAN tools: candump -L logs (tools/can_log), SocketCAN (hal/linux) and drive_monitor.
 # Test names contain can_log, socketcan or monitor; all are in the unit tier.
-imd_add_test(test_can_log unit unit/test_can_log.cpp)
-target_link_libraries(test_can_log PRIVATE imd_can_log)
-imd_add_test(test_drive_monitor unit unit/test_drive_monitor.cpp)
-target_link_libraries(test_drive_monitor PRIVATE imd_drive_monitor)
-if(TARGET imd_hal_linux)
-  imd_add_test(test_socketcan_bus unit unit/test_socketcan_bus.cpp)
-  target_link_libraries(test_socketcan_bus PRIVATE imd_hal_linux)
-endif()
+imd_add_test(test_can_log unit LIBRARIES imd_can_log SOURCES tools/test_can_log.cpp)
+imd_add_test(test_drive_monitor unit LIBRARIES imd_drive_monitor SOURCES tools/test_drive_monitor.cpp)
 
 # drive_monitor: exit code 2 and a clear message on bad input (the interface is checked on a
 # machine that may have no CAN at all: either message is clear), decoding of a recorded log.

@@ -5,6 +5,8 @@
 /// CAN protocol's value table, firmware/protocol/messages.hpp). docs/architecture.md, "How to
 /// add a control law".
 #include <array>
+#include <iterator>
+#include <string_view>
 #include <tuple>
 #include <utility>
 
@@ -13,11 +15,26 @@
 #include "firmware/laws/dsmc_law.hpp"
 #include "firmware/laws/iol_law.hpp"
 #include "firmware/laws/law_context.hpp"
+#include "firmware/protocol/messages.hpp"
 
 namespace imd::firmware {
 
 template <typename T>
 using Laws = std::tuple<DsmcLaw<T>, IolLaw<T>>;
+
+/// The law of this name ("dsmc", "iol": the CAN protocol's value table, which the DBC
+/// carries); false for no such law. Construction and configuration only.
+inline bool controller_named(std::string_view name, ControllerKind& kind) noexcept {
+  for (const protocol::ValueName& v : protocol::kControllerValues) {
+    if (name == v.name) {
+      kind = static_cast<ControllerKind>(v.raw);
+      return true;
+    }
+  }
+  return false;
+}
+static_assert(std::size(protocol::kControllerValues) == kControllerCount,
+              "every law has its name in the protocol's value table");
 
 template <typename T>
 class LawRegistry {

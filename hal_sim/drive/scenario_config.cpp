@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "control/frames.hpp"
+#include "firmware/laws/law_registry.hpp"
 
 namespace imd::sim {
 
@@ -24,8 +25,9 @@ SimBoardConfig board_config(const Scenario& s) {
 firmware::DriveConfig drive_config(const Scenario& s) {
   firmware::DriveConfig c;
   c.sample_period_s = s.sample_period_s;
-  c.controller =
-      s.controller == "iol" ? firmware::ControllerKind::iol : firmware::ControllerKind::dsmc;
+  // The loader accepts only the laws' names (hal_sim/scenario.cpp); an unknown one would
+  // have stopped there.
+  firmware::controller_named(s.controller, c.controller);
   c.iol_period_s = s.iol_period_s;
   // The ideal current source imposes the current at once; the deadbeat loop a tick later.
   c.current_response_ticks = s.current_fed ? 0 : 1;
