@@ -65,12 +65,12 @@ send set-telemetry-rate 50 > /tmp/commands.log 2>&1
 wait_state idle 10 || abort "no idle after calibration"
 send enable >> /tmp/commands.log 2>&1
 # Keep the watchdog fed until the drive runs, then step the speed to 30 rad/s for 6 s.
-drive_monitor send $NODE set-speed 0 --repeat-hz 10 --for-s 20 >> /tmp/commands.log 2>&1 &
+drive_monitor send $NODE set-speed 0 --repeat-hz 10 --for-s 20 --wait-heartbeat-s 5 >> /tmp/commands.log 2>&1 &
 KEEP=$!
 wait_state running 15 || { kill -INT $KEEP; abort "not running"; }
 kill -INT $KEEP; wait $KEEP
 echo "marker step" >> /tmp/commands.log
-drive_monitor send $NODE set-speed 30 --repeat-hz 10 --for-s 6 >> /tmp/commands.log 2>&1
+drive_monitor send $NODE set-speed 30 --repeat-hz 10 --for-s 6 --wait-heartbeat-s 5 >> /tmp/commands.log 2>&1
 echo "marker silence" >> /tmp/commands.log
 wait_state fault 10 || abort "no watchdog fault"  # the command watchdog (1 s)
 send clear-faults >> /tmp/commands.log 2>&1
