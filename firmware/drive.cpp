@@ -72,7 +72,8 @@ inline Estimate<T> Drive<T>::estimate(const Measurement<T>& m) noexcept {
 }
 
 template <typename T>
-inline LawOutput<T> Drive<T>::law(const TickPlan<T>& plan, const Estimate<T>& e, T v_bus_V) noexcept {
+inline LawOutput<T> Drive<T>::law(const TickPlan<T>& plan, const Estimate<T>& e,
+                                  T v_bus_V) noexcept {
   record_.law.speed_saturated = record_.law.flux_saturated = record_.law.iol_boundary = false;
   if (plan.mode == Mode::off) return {};
   const control::InputDisk<T> feasible = limits_.feasible(e.x_input, v_bus_V);
@@ -85,7 +86,7 @@ inline LawOutput<T> Drive<T>::law(const TickPlan<T>& plan, const Estimate<T>& e,
 
 template <typename T>
 inline void Drive<T>::actuate(uint64_t k, const Estimate<T>& e, const Modulation<T>& out,
-                       const Trip& trip) noexcept {
+                              const Trip& trip) noexcept {
   v_applied_V_ = Vec2::Zero();
   if (trip.any()) {
     supervisor_.latch(trip, k);
@@ -113,14 +114,14 @@ inline void Drive<T>::check_budget(uint64_t k, uint32_t counts) noexcept {
   if (!overrun.any()) return;
   ++execution_.overruns;
   supervisor_.latch(overrun, k);
-  pwm_off();                       // the PWM is off before the next period starts
-  predictor_.cancel_in_flight();   // so this tick's voltage never acts
+  pwm_off();                      // the PWM is off before the next period starts
+  predictor_.cancel_in_flight();  // so this tick's voltage never acts
 }
 
 template <typename T>
 inline void Drive<T>::publish(uint64_t k, const Measurement<T>& m, const Estimate<T>& e,
-                       const TickPlan<T>& plan, const LawOutput<T>& u,
-                       const Modulation<T>& out) noexcept {
+                              const TickPlan<T>& plan, const LawOutput<T>& u,
+                              const Modulation<T>& out) noexcept {
   TickRecord<T>& r = record_;
   r.tick = k;
   r.v_bus_V = m.v_bus_V;

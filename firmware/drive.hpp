@@ -93,13 +93,13 @@ class Drive final : public hal::TickHandler {
   [[gnu::always_inline]] LawOutput<T> law(const TickPlan<T>& plan, const Estimate<T>& e,
                                           T v_bus_V) noexcept;
   /// The PWM write, or the PWM off with a fault latched; the observers learn what acts.
-  [[gnu::always_inline]] void actuate(uint64_t k, const Estimate<T>& e,
-                                      const Modulation<T>& out, const Trip& trip) noexcept;
+  [[gnu::always_inline]] void actuate(uint64_t k, const Estimate<T>& e, const Modulation<T>& out,
+                                      const Trip& trip) noexcept;
   /// The execution time up to the PWM write, against its budget.
   [[gnu::always_inline]] void check_budget(uint64_t k, uint32_t counts) noexcept;
   [[gnu::always_inline]] void publish(uint64_t k, const Measurement<T>& m, const Estimate<T>& e,
-               const TickPlan<T>& plan, const LawOutput<T>& u,
-               const Modulation<T>& out) noexcept;
+                                      const TickPlan<T>& plan, const LawOutput<T>& u,
+                                      const Modulation<T>& out) noexcept;
   void pwm_off() noexcept;
   /// Drives one of the board's output lines (nothing when the line is not wired).
   void write_line(int line, bool level) noexcept;

@@ -33,7 +33,8 @@ Supervisor<T>::Supervisor(const DriveConfig& config, const SupervisorWiring& wir
       decoder_(config.node_id, {float(config.protection.overspeed_rad_s),
                                 float(config.min_flux2_command_Wb2), float(config.max_flux2_Wb2)}),
       ramp_(config.max_accel_rad_s2, config.sample_period_s),
-      command_accel_step_rad_s_(SpeedRamp<T>::step(config.max_accel_rad_s2, config.sample_period_s)),
+      command_accel_step_rad_s_(
+          SpeedRamp<T>::step(config.max_accel_rad_s2, config.sample_period_s)),
       stop_accel_step_rad_s_(SpeedRamp<T>::step(
           std::min(config.max_accel_rad_s2, config.stop_decel_rad_s2), config.sample_period_s)),
       stop_speed_rad_s_(T(config.stop_speed_rad_s)),
@@ -101,8 +102,9 @@ TickPlan<T> Supervisor<T>::plan(uint64_t k, const Measurement<T>& m,
       }
     }
     // A stop is complete once the ramp is at zero and the motor (nearly) still.
-    if (p.stopping && ((ramp_.value() == T(0) && std::abs(e.x.omega_mech_rad_s) < stop_speed_rad_s_) ||
-                       k - stop_start_tick_ > stop_timeout_ticks_)) {
+    if (p.stopping &&
+        ((ramp_.value() == T(0) && std::abs(e.x.omega_mech_rad_s) < stop_speed_rad_s_) ||
+         k - stop_start_tick_ > stop_timeout_ticks_)) {
       machine_.go(DriveState::idle, TransitionReason::stopped, k);
       p.mode = Mode::off;
     }

@@ -81,8 +81,7 @@ class Supervisor {
   ControlledFlux controlled_flux() const noexcept { return controlled_flux_; }
 
  private:
-  [[gnu::always_inline]] void references(uint64_t k, const Estimate<T>& e,
-                                         TickPlan<T>& p) noexcept;
+  [[gnu::always_inline]] void references(uint64_t k, const Estimate<T>& e, TickPlan<T>& p) noexcept;
   // Commands (supervisor_commands.cpp).
   void receive_commands(uint64_t k, TickPlan<T>& p) noexcept;
   protocol::CommandResult apply(const protocol::Command& command, uint64_t k,

@@ -65,7 +65,7 @@ protocol::CommandResult Supervisor<T>::apply(const protocol::Command& c, uint64_
                  ? CommandResult::accepted
                  : CommandResult::not_allowed;
     case CommandKind::disable:
-      commanded_.set_speed(T(0));           // a later enable waits for a new speed
+      commanded_.set_speed(T(0));          // a later enable waits for a new speed
       if (s == DriveState::magnetizing) {  // no motion to stop yet: the PWM goes off
         machine_.go(DriveState::idle, TransitionReason::disable, k);
       } else if (s == DriveState::running) {
@@ -108,10 +108,10 @@ protocol::CommandResult Supervisor<T>::apply(const protocol::Command& c, uint64_
 }
 
 // The class is instantiated in supervisor.cpp; these members are defined here.
-#define IMD_INSTANTIATE_COMMANDS(T)                                                          \
-  template void Supervisor<T>::receive_commands(uint64_t, TickPlan<T>&) noexcept;            \
-  template void Supervisor<T>::enable(uint64_t, TickPlan<T>&) noexcept;                      \
-  template void Supervisor<T>::clear_faults(uint64_t, TickPlan<T>&) noexcept;                \
+#define IMD_INSTANTIATE_COMMANDS(T)                                                         \
+  template void Supervisor<T>::receive_commands(uint64_t, TickPlan<T>&) noexcept;           \
+  template void Supervisor<T>::enable(uint64_t, TickPlan<T>&) noexcept;                     \
+  template void Supervisor<T>::clear_faults(uint64_t, TickPlan<T>&) noexcept;               \
   template protocol::CommandResult Supervisor<T>::apply(const protocol::Command&, uint64_t, \
                                                         TickPlan<T>&) noexcept;
 IMD_INSTANTIATE_COMMANDS(float)

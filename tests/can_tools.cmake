@@ -58,7 +58,6 @@ if(TARGET drive_monitor)
 endif()
 
 # libFuzzer harnesses (clang only): the fuzz preset turns them on.
-option(IMD_BUILD_FUZZERS "Build the libFuzzer harnesses (clang; see the fuzz preset)" OFF)
 if(IMD_BUILD_FUZZERS)
   add_subdirectory(fuzz)
 endif()

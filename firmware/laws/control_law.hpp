@@ -18,9 +18,9 @@ enum class ControlledFlux : uint8_t { rotor, stator };
 
 template <typename T>
 struct LawInput {
-  const Estimate<T>& e;      ///< the state at this tick and at the input's period (x_input)
-  const Reference<T>& now;   ///< references at x_input's step, the speed through the ramp
-  const Reference<T>& next;  ///< at the step after: what the input should reach
+  const Estimate<T>& e;       ///< the state at this tick and at the input's period (x_input)
+  const Reference<T>& now;    ///< references at x_input's step, the speed through the ramp
+  const Reference<T>& next;   ///< at the step after: what the input should reach
   const Reference<T>& ahead;  ///< lookahead_ticks() ahead (the speed still next's)
   bool stopping;
   const control::InputDisk<T>& feasible;  ///< the inputs the voltage and current limits allow

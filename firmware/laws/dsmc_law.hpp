@@ -14,9 +14,9 @@ class DsmcLaw final : public ControlLaw<T> {
   static constexpr ControllerKind kKind = ControllerKind::dsmc;
 
   explicit DsmcLaw(const LawContext& c) noexcept
-      : dsmc_(c.coefficients, control::DsmcConfig{c.config.min_flux2_Wb2,
-                                                  c.config.speed_reaching_pole,
-                                                  c.config.flux_reaching_pole}) {}
+      : dsmc_(c.coefficients,
+              control::DsmcConfig{c.config.min_flux2_Wb2, c.config.speed_reaching_pole,
+                                  c.config.flux_reaching_pole}) {}
 
   ControlledFlux controlled_flux() const noexcept override { return ControlledFlux::rotor; }
   bool follows_speed() const noexcept override { return true; }

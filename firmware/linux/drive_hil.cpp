@@ -136,8 +136,7 @@ int run(const Options& o, const imd::sim::Scenario& s, imd::hal::QueuedCanBus* c
                                    {s.ideal_sensors, s.inner_feedback, s.current_fed},
                                    &references, timer, can, gpio);
   firmware::Drive<T>& drive = simulated.drive();
-  firmware::HilTick<T> tick(board, drive, s.faults,
-                            sim::observed_run(sim::profiles(s), s.settle_s, s.motor, config));
+  firmware::HilTick<T> tick(board, drive, s.faults);
 
   std::cerr << fmt::format("drive_hil: {} on {} as node {}, {} Hz, {} precision{}\n", s.source,
                            can != nullptr ? can->iface() : "no CAN bus", o.node,
@@ -176,12 +175,6 @@ int run(const Options& o, const imd::sim::Scenario& s, imd::hal::QueuedCanBus* c
   facts.can_iface = can != nullptr ? can->iface() : "none";
   if (can != nullptr) facts.can = can->counters();
   std::cout << firmware::report_text(facts) << std::flush;
-  const sim::TickObserver<T>& observed = tick.observer();
-  std::cerr << fmt::format("drive_hil: tracking after {} s: speed rms error {:.4g} rad/s, "
-                           "squared flux rms error {:.4g} Wb^2, peak current {:.4g} A\n",
-                           s.settle_s, observed.speed_rms_err_rad_s(),
-                           observed.metrics().flux2_rms_err_Wb2(),
-                           observed.metrics().i_peak_total_A());
 
   int status = reason == "plant diverged" ? kExitFailed : 0;
   if (status != 0) std::cerr << "drive_hil: the simulated plant diverged (NaN): run stopped\n";

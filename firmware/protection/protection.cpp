@@ -29,15 +29,14 @@ Protection<T>::Protection(const control::MotorParameters& motor, const DriveConf
       bus_max_V_(T(config.protection.bus_max_V)),
       overspeed_rad_s_(T(config.protection.overspeed_rad_s)),
       pole_pairs_(T(motor.pole_pairs)),
-      torque_per_AWb_(
-          T(control::kClarkeTorqueFactor * motor.pole_pairs * motor.Lm_H / motor.Lr_H)),
-      magnetizing_timeout_ticks_(saturated(
-          duration_ticks(config.magnetizing_timeout_s, config.sample_period_s))),
-      command_timeout_ticks_(saturated(
-          duration_ticks(config.protection.command_timeout_s, config.sample_period_s))),
+      torque_per_AWb_(T(control::kClarkeTorqueFactor * motor.pole_pairs * motor.Lm_H / motor.Lr_H)),
+      magnetizing_timeout_ticks_(
+          saturated(duration_ticks(config.magnetizing_timeout_s, config.sample_period_s))),
+      command_timeout_ticks_(
+          saturated(duration_ticks(config.protection.command_timeout_s, config.sample_period_s))),
       encoder_check_({counts_per_rev, config.sample_period_s, motor.J_kgm2, motor.friction_Nms,
-                      config.protection.encoder_missing_counts,
-                      config.protection.encoder_window_s, config.protection.overspeed_rad_s}),
+                      config.protection.encoder_missing_counts, config.protection.encoder_window_s,
+                      config.protection.overspeed_rad_s}),
       adc_stuck_check_(config.protection.adc_stuck_ticks, config.sample_period_s,
                        control::derive_voltage_fed(motor).sigma_H, adc_A_per_code),
       phase_loss_check_(config.protection.phase_loss_ratio,
@@ -84,8 +83,8 @@ Trip Protection<T>::check(const Measurement<T>& m, const Estimate<T>& e, const S
 }
 
 template <typename T>
-inline void Protection<T>::check_sensed(const Measurement<T>& m, const Estimate<T>& e, bool modulating,
-                                 Trip& trip) noexcept {
+inline void Protection<T>::check_sensed(const Measurement<T>& m, const Estimate<T>& e,
+                                        bool modulating, Trip& trip) noexcept {
   if (m.i_peak_A > overcurrent_A_ || m.adc_saturated) {
     int phase = 0;
     for (int i = 1; i < 3; ++i) {
@@ -110,8 +109,8 @@ inline void Protection<T>::check_sensed(const Measurement<T>& m, const Estimate<
 
 template <typename T>
 inline void Protection<T>::check_driving(const Measurement<T>& m, const Estimate<T>& e,
-                                  const SupervisedState& s, const control::Vec2<T>& u_last_V,
-                                  Trip& trip) noexcept {
+                                         const SupervisedState& s, const control::Vec2<T>& u_last_V,
+                                         Trip& trip) noexcept {
   if (!(m.v_bus_V >= bus_min_V_)) trip.add(FaultCode::bus_undervoltage);  // NaN too
   if (config_.check_adc_stuck && adc_stuck_check_.stuck(m.phase_code, u_last_V)) {
     trip.add(FaultCode::adc_stuck);

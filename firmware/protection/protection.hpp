@@ -29,11 +29,11 @@ namespace imd::firmware {
 
 /// What the supervisor knows that the checks need (TickPlan carries it).
 struct SupervisedState {
-  bool modulating = false;     ///< magnetizing, running or stopping: the inverter drives
-  bool enable_input = true;    ///< the board's enable input (true without one)
-  bool restarted = false;      ///< enabled or cleared this tick: the checks start afresh
+  bool modulating = false;   ///< magnetizing, running or stopping: the inverter drives
+  bool enable_input = true;  ///< the board's enable input (true without one)
+  bool restarted = false;    ///< enabled or cleared this tick: the checks start afresh
   bool magnetizing = false;
-  bool watchdog_armed = false;  ///< CAN-commanded and magnetizing or running
+  bool watchdog_armed = false;         ///< CAN-commanded and magnetizing or running
   uint32_t magnetizing_ticks = 0;      ///< since magnetizing began (saturates)
   uint32_t command_silence_ticks = 0;  ///< since the last valid command (saturates)
 };
@@ -54,10 +54,11 @@ class Protection {
   void set_clock(uint32_t clock_Hz) noexcept;
 
  private:
-  [[gnu::always_inline]] void check_sensed(const Measurement<T>& m, const Estimate<T>& e, bool modulating,
-                    Trip& trip) noexcept;
-  [[gnu::always_inline]] void check_driving(const Measurement<T>& m, const Estimate<T>& e, const SupervisedState& s,
-                     const control::Vec2<T>& u_last_V, Trip& trip) noexcept;
+  [[gnu::always_inline]] void check_sensed(const Measurement<T>& m, const Estimate<T>& e,
+                                           bool modulating, Trip& trip) noexcept;
+  [[gnu::always_inline]] void check_driving(const Measurement<T>& m, const Estimate<T>& e,
+                                            const SupervisedState& s,
+                                            const control::Vec2<T>& u_last_V, Trip& trip) noexcept;
 
   ProtectionConfig config_;
   bool commands_over_can_;

@@ -13,9 +13,9 @@ namespace imd::firmware {
 
 template <typename T>
 struct Estimate {
-  bool valid = false;                ///< a valid measurement was estimated from
-  control::RotorFrameState<T> x;     ///< at this tick
-  T load_Nm = T(0);                  ///< load torque (estimate), held over the period
+  bool valid = false;             ///< a valid measurement was estimated from
+  control::RotorFrameState<T> x;  ///< at this tick
+  T load_Nm = T(0);               ///< load torque (estimate), held over the period
   /// The state at the start of the period this tick's input acts on (x predicted over the PWM
   /// latency; x itself without latency), position wrapped to (-pi, pi]: what the law acts on.
   control::RotorFrameState<T> x_input;

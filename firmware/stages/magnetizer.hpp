@@ -65,8 +65,8 @@ class Magnetizer {
                     ControlledFlux kind, const control::InputDisk<T>& feasible) const noexcept {
     LawOutput<T> out;
     out.i_cmd_AB_A = current_AB_A(x_input, ref, kind);
-    out.v_AB_V = current_loop_.input(x_input.flux_r_AB_Wb, x_input.i_s_AB_A, out.i_cmd_AB_A,
-                                     feasible);
+    out.v_AB_V =
+        current_loop_.input(x_input.flux_r_AB_Wb, x_input.i_s_AB_A, out.i_cmd_AB_A, feasible);
     return out;
   }
 

@@ -42,10 +42,11 @@ Measurement<T> BoardSensing<T>::measure(bool calibrating) noexcept {
   for (int phase = 0; phase < 3; ++phase) {
     m.i_abc_A[phase] = (T(sample.phase_code[phase]) - offset_code_[phase]) * A_per_code_;
     m.i_peak_A = std::max(m.i_peak_A, std::abs(m.i_abc_A[phase]));
-    m.adc_saturated = m.adc_saturated || sample.phase_code[phase] == 0 ||
-                      sample.phase_code[phase] >= max_code_;
+    m.adc_saturated =
+        m.adc_saturated || sample.phase_code[phase] == 0 || sample.phase_code[phase] >= max_code_;
   }
-  m.i_alphabeta_A = control::clarke(control::PhaseValues<T>{m.i_abc_A[0], m.i_abc_A[1], m.i_abc_A[2]});
+  m.i_alphabeta_A =
+      control::clarke(control::PhaseValues<T>{m.i_abc_A[0], m.i_abc_A[1], m.i_abc_A[2]});
   m.valid = true;
   return m;
 }

@@ -24,7 +24,10 @@ class StageClock {
   /// one tick in N (DriveConfig::stage_timing_period_ticks), because every read of the clock
   /// costs a share of the tick itself.
   StageClock(const hal::ControlTimer& timer, StageCounts& counts, bool timed) noexcept
-      : timer_(timer), counts_(counts), timed_(timed), start_(timer.execution_counts()),
+      : timer_(timer),
+        counts_(counts),
+        timed_(timed),
+        start_(timer.execution_counts()),
         last_(start_) {}
 
   /// Ends `stage`: its duration is the time since the last lap.

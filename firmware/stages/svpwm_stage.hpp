@@ -32,9 +32,9 @@ class SvpwmStage final : public PowerStage<T> {
     if (pwm.clipped) {
       const T limit = control::svpwm_linear_limit_V(v_bus_V);
       const T magnitude = m.u_alphabeta_V.norm();
-      m.v_acting_AB_V = rotation.apply_inverse(m.u_alphabeta_V *
-                                               (magnitude > limit ? limit / magnitude : T(1))) -
-                        compensation;
+      m.v_acting_AB_V =
+          rotation.apply_inverse(m.u_alphabeta_V * (magnitude > limit ? limit / magnitude : T(1))) -
+          compensation;
     }
     m.finite = finite(m.u_alphabeta_V) && finite(m.v_acting_AB_V);
     m.duty = {float(pwm.duty[0]), float(pwm.duty[1]), float(pwm.duty[2])};

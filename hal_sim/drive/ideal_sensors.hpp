@@ -28,9 +28,9 @@ class IdealSensors final : public firmware::Sensing<T>, public firmware::StateEs
              {config.adc_calibration_ticks, config.adc_offset_limit_A}),
         coefficients_(control::discretize_voltage_fed(motor, config.sample_period_s)),
         flux_(coefficients_),
-        load_(coefficients_, control::place_load_estimator(coefficients_,
-                                                           config.load_estimator_pole,
-                                                           config.load_estimator_pole)),
+        load_(coefficients_,
+              control::place_load_estimator(coefficients_, config.load_estimator_pole,
+                                            config.load_estimator_pole)),
         section_iv_(config.section_iv_load_estimator),
         pole_pairs_(T(motor.pole_pairs)) {}
 
@@ -38,9 +38,8 @@ class IdealSensors final : public firmware::Sensing<T>, public firmware::StateEs
     firmware::Measurement<T> m = adc_.measure(calibrating);  // the bus, the calibration
     if (!m.valid) return m;
     read_truth();
-    const auto i_abc = control::inverse_clarke(
-        control::Vec2<T>(control::Rotation<T>::from_angle(pole_pairs_ * theta_mech_rad_)
-                             .apply(i_s_AB_A_)));
+    const auto i_abc = control::inverse_clarke(control::Vec2<T>(
+        control::Rotation<T>::from_angle(pole_pairs_ * theta_mech_rad_).apply(i_s_AB_A_)));
     m.adc_saturated = false;  // the ADC's currents are not used
     m.i_peak_A = std::max({std::abs(i_abc[0]), std::abs(i_abc[1]), std::abs(i_abc[2])});
     for (int phase = 0; phase < 3; ++phase) m.i_abc_A[phase] = i_abc[phase];

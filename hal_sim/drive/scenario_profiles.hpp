@@ -11,7 +11,7 @@ namespace imd::sim {
 struct ScenarioProfiles {
   SpeedProfile speed;
   double flux2_Wb2 = 0.2;         ///< squared rotor flux (dsmc)
-  LoadProfile torque;        ///< torque reference (iol without the outer speed loop)
+  LoadProfile torque;             ///< torque reference (iol without the outer speed loop)
   double stator_flux2_Wb2 = 0.0;  ///< squared stator flux (iol)
 
   firmware::Reference<double> at(double t_s) const noexcept {
@@ -23,7 +23,7 @@ struct ScenarioProfiles {
 /// once to T.
 template <typename T>
 firmware::Reference<T> reference_at_tick(const ScenarioProfiles& profiles, double period_s,
-                               uint64_t k) noexcept {
+                                         uint64_t k) noexcept {
   const firmware::Reference<double> r = profiles.at(double(k) * period_s);
   return {T(r.omega_mech_rad_s), T(r.flux2_Wb2), T(r.torque_Nm), T(r.stator_flux2_Wb2)};
 }

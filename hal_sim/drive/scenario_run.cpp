@@ -8,15 +8,15 @@
 #include "control/current_fed_model.hpp"
 #include "control/frames.hpp"
 #include "firmware/drive.hpp"
-#include "hal_sim/run_metrics.hpp"
-#include "hal_sim/drive/scenario_config.hpp"
 #include "hal_sim/drive/lockstep_period.hpp"
+#include "hal_sim/drive/scenario_config.hpp"
+#include "hal_sim/drive/scripted_commands.hpp"
 #include "hal_sim/drive/simulated_drive.hpp"
 #include "hal_sim/drive/stage_totals.hpp"
 #include "hal_sim/fault_schedule.hpp"
+#include "hal_sim/run_metrics.hpp"
 #include "hal_sim/sim_board.hpp"
 #include "hal_sim/sim_can_host.hpp"
-#include "hal_sim/drive/scripted_commands.hpp"
 
 namespace imd::sim {
 namespace {
@@ -129,9 +129,9 @@ Summary run(const Scenario& s, const RunCallbacks& callbacks) {
   summary.running_from_s = observer.running_from_s();
   const double ns_per_count = 1e9 / double(drive.execution_clock_Hz());
   for (int i = 0; i < firmware::kStageCount; ++i) {
-    summary.stage_ns_mean[i] = stages.ticks ? double(stages.counts[i]) * ns_per_count /
-                                                  double(stages.ticks)
-                                            : std::nan("");
+    summary.stage_ns_mean[i] = stages.ticks
+                                   ? double(stages.counts[i]) * ns_per_count / double(stages.ticks)
+                                   : std::nan("");
   }
   summary.tick_exec_ns_mean = drive.execution().mean_ns();
   summary.tick_exec_ns_max = drive.execution().max_ns;

@@ -30,8 +30,7 @@ class SimulatedDrive {
       : ideal_(board, motor, config),
         analog_(board),
         current_source_(board),
-        drive_(motor, config,
-               {board.pwm(), board.encoder(), board.adc(), timer, can, gpio},
+        drive_(motor, config, {board.pwm(), board.encoder(), board.adc(), timer, can, gpio},
                substitutes(parts, references)) {}
 
   firmware::Drive<T>& drive() noexcept { return drive_; }

@@ -59,7 +59,11 @@ inline ObservedRun observed_run(const ScenarioProfiles& references, double settl
                                 const control::MotorParameters& motor,
                                 const firmware::DriveConfig& drive) {
   const bool iol = drive.controller == firmware::ControllerKind::iol;
-  return {references, settle_s, motor.pole_pairs, iol, !(iol && !drive.outer_speed_loop),
+  return {references,
+          settle_s,
+          motor.pole_pairs,
+          iol,
+          !(iol && !drive.outer_speed_loop),
           drive.commands_over_can,
           control::discretize_current_fed(motor, drive.iol_period_s).flux_decay};
 }
@@ -71,8 +75,8 @@ class TickObserver {
 
   /// Tick k's row: `truth` and `load_Nm` at t_k (before the tick), `board` after its period,
   /// `rec` the drive's record of the tick. Adds it to the metrics.
-  const SimRow& observe(double t_s, const PlantState& truth, double load_Nm,
-                        const SimBoard& board, const firmware::TickRecord<T>& rec) noexcept;
+  const SimRow& observe(double t_s, const PlantState& truth, double load_Nm, const SimBoard& board,
+                        const firmware::TickRecord<T>& rec) noexcept;
 
   const RunMetrics& metrics() const noexcept { return metrics_; }
   /// NaN when the run has no speed reference (torque control) or nothing was measured.
@@ -100,7 +104,7 @@ class TickObserver {
   double running_from_s_ = -1.0;
   double torque_sq_ = 0, hold_sq_ = 0;
   uint64_t torque_count_ = 0, hold_count_ = 0;
-  Vec2 boundary_flux_s_ = Vec2::Zero();      ///< true stator flux (rotor frame), last boundary
+  Vec2 boundary_flux_s_ = Vec2::Zero();       ///< true stator flux (rotor frame), last boundary
   double pending_torque_cmd_ = std::nan("");  ///< the law's v1, due at the next boundary
   double held_torque_ref_Nm_ = 0.0, held_y2_ = 0.0, held_y2_ref_ = 0.0;  ///< of the boundary
 };
@@ -116,8 +120,7 @@ const SimRow& TickObserver<T>::observe(double t_s, const PlantState& truth, doub
   row.omega_ref_rad_s =
       run_.commands_over_can ? double(rec.omega_ref_rad_s) : run_.references.speed.at(t_s);
   row.omega_est_rad_s = rec.omega_est_rad_s;
-  const auto rotor =
-      control::Rotation<double>::from_angle(run_.pole_pairs * truth.theta_mech_rad);
+  const auto rotor = control::Rotation<double>::from_angle(run_.pole_pairs * truth.theta_mech_rad);
   const Vec2 flux_AB = rotor.apply_inverse(truth.flux_r_alphabeta_Wb);
   row.flux_A_Wb = flux_AB.x();
   row.flux_B_Wb = flux_AB.y();
@@ -140,8 +143,7 @@ const SimRow& TickObserver<T>::observe(double t_s, const PlantState& truth, doub
   const Vec2 flux_s_AB = rotor.apply_inverse(board.start_flux_s_alphabeta_Wb());
   row.stator_flux2_Wb2 = flux_s_AB.squaredNorm();
   row.stator_flux2_ref_Wb2 = run_.references.stator_flux2_Wb2;
-  observe_current_fed(t_s, flux_s_AB, rotor.apply_inverse(board.start_current_alphabeta_A()),
-                      rec);
+  observe_current_fed(t_s, flux_s_AB, rotor.apply_inverse(board.start_current_alphabeta_A()), rec);
   row.state = static_cast<int>(rec.state);
   row.omega_ref_cmd_rad_s = rec.omega_ref_rad_s;
   row.flux2_ctrl_est_Wb2 = rec.controlled_flux2_Wb2;
@@ -156,8 +158,7 @@ const SimRow& TickObserver<T>::observe(double t_s, const PlantState& truth, doub
   const bool running = rec.state == firmware::DriveState::running;
   if (running_from_s_ < 0 && running) running_from_s_ = t_s;
   // Over CAN the drive is stopped and started at the host's will: only running ticks count.
-  metrics_.add({t_s, !run_.commands_over_can || running,
-                row.omega_mech_rad_s - row.omega_ref_rad_s,
+  metrics_.add({t_s, !run_.commands_over_can || running, row.omega_mech_rad_s - row.omega_ref_rad_s,
                 run_.current_fed_law ? row.stator_flux2_Wb2 - row.stator_flux2_ref_Wb2
                                      : row.flux2_Wb2 - row.flux2_ref_Wb2,
                 row.load_est_Nm - row.load_Nm, truth.i_s_alphabeta_A.norm(), row.saturated});

@@ -71,11 +71,9 @@ TEST(Protection, UndervoltageIsJudgedOnlyWhileDriving) {
   b.s.modulating = false;
   EXPECT_FALSE(p.check(b.m, b.e, b.s, b.law, b.out, Vec2::Zero()).any());
   b.s.modulating = true;
-  EXPECT_EQ(p.check(b.m, b.e, b.s, b.law, b.out, Vec2::Zero()).first,
-            FaultCode::bus_undervoltage);
+  EXPECT_EQ(p.check(b.m, b.e, b.s, b.law, b.out, Vec2::Zero()).first, FaultCode::bus_undervoltage);
   b.m.v_bus_V = std::numeric_limits<double>::quiet_NaN();  // a NaN reading is no bus
-  EXPECT_EQ(p.check(b.m, b.e, b.s, b.law, b.out, Vec2::Zero()).first,
-            FaultCode::bus_undervoltage);
+  EXPECT_EQ(p.check(b.m, b.e, b.s, b.law, b.out, Vec2::Zero()).first, FaultCode::bus_undervoltage);
 }
 
 TEST(Protection, TheEnableInputMattersOnlyWhileDriving) {

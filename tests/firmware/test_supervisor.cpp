@@ -116,8 +116,8 @@ TEST(Supervisor, TheFirstFaultIsKeptAndEveryBitIsLatched) {
   EXPECT_EQ(b.supervisor.status().first_fault, FaultCode::phase_loss);
   EXPECT_EQ(b.supervisor.status().fault_detail, 2);
   EXPECT_EQ(b.supervisor.status().first_fault_tick, 10u);
-  EXPECT_EQ(b.supervisor.status().fault_bits, (1u << unsigned(FaultCode::phase_loss)) |
-                                                 (1u << unsigned(FaultCode::overcurrent)));
+  EXPECT_EQ(b.supervisor.status().fault_bits,
+            (1u << unsigned(FaultCode::phase_loss)) | (1u << unsigned(FaultCode::overcurrent)));
   int reports = 0;
   for (const hal::CanFrame& f : b.can.sent) {
     reports += f.id == protocol::can_id(1, protocol::MessageId::fault_report) ? 1 : 0;

@@ -29,8 +29,8 @@ void expect_same(double pil, double drive_sim, const char* what) {
 }
 
 TEST(LockstepAgreement, ThePilLoopGivesDriveSimsMetricsOnTheCurrentFedLaw) {
-  const Scenario s = load_scenario(std::string(IMD_SOURCE_DIR) +
-                                   "/hal_sim/scenarios/seed001_realistic.toml");
+  const Scenario s =
+      load_scenario(std::string(IMD_SOURCE_DIR) + "/hal_sim/scenarios/seed001_realistic.toml");
   ASSERT_EQ(s.controller, "iol");
   const Summary reference = run_scenario(s);
 
@@ -41,8 +41,8 @@ TEST(LockstepAgreement, ThePilLoopGivesDriveSimsMetricsOnTheCurrentFedLaw) {
   LookaheadReferences<double> references(references_profile, s.sample_period_s);
   const firmware::DriveConfig config = drive_config(s);
   SimulatedDrive<double> simulated(board, s.motor, config,
-                                   {s.ideal_sensors, s.inner_feedback, s.current_fed},
-                                   &references, board.timer(), &board.can());
+                                   {s.ideal_sensors, s.inner_feedback, s.current_fed}, &references,
+                                   board.timer(), &board.can());
   firmware::Drive<double>& drive = simulated.drive();
   TickObserver<double> observer(observed_run(references_profile, s.settle_s, s.motor, config));
   const auto ticks = static_cast<uint64_t>(std::llround(s.duration_s / s.sample_period_s));

@@ -1,0 +1,12 @@
+# Every build option of the project, in one place (the presets in CMakePresets.json set them).
+option(IMD_BUILD_TESTS "Build the GoogleTest tiers (off: aarch64 and cortex-m4f presets)" ON)
+option(IMD_BUILD_BENCHMARKS "Build the Google Benchmark programs (off: all presets but host)" ON)
+# Static programs run in a bare initramfs or on a board without the build's shared libraries.
+option(IMD_STATIC_LINK "Link the programs statically (the aarch64 preset)" OFF)
+option(IMD_QEMU_TIER
+       "Build the static programs of the qemu test tier and register its tests (off: asan, fuzz)"
+       ON)
+option(IMD_BUILD_FUZZERS "Build the libFuzzer harnesses (clang: the fuzz preset)" OFF)
+# Off by default, so that a user's newer compiler with new warnings still builds; the presets
+# CI builds turn it on.
+option(IMD_WARNINGS_AS_ERRORS "Compile with -Werror (the host and cortex-m4f presets)" OFF)
