@@ -9,4 +9,4 @@ option(IMD_QEMU_TIER
 option(IMD_BUILD_FUZZERS "Build the libFuzzer harnesses (clang: the fuzz preset)" OFF)
 # Off by default, so that a user's newer compiler with new warnings still builds; the presets
 # CI builds turn it on.
-option(IMD_WARNINGS_AS_ERRORS "Compile with -Werror (the host and cortex-m4f presets)" OFF)
+option(IMD_WARNINGS_AS_ERRORS "Compile with -Werror (every preset CI or the qemu tier builds)" OFF)

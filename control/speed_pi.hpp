@@ -30,10 +30,11 @@ class SpeedPi {
         ki_T0_(T(c.ki_Nm_per_rad * c.period_s)),
         limit_(T(c.torque_limit_Nm)) {}
 
-  /// Torque reference from the speed error. Returns a value within +-limit.
-  T step(T omega_ref_rad_s, T omega_rad_s) noexcept {
+  /// Torque reference from the speed error and a torque feed-forward (the torque the
+  /// reference's acceleration and the friction take). Returns a value within +-limit.
+  T step(T omega_ref_rad_s, T omega_rad_s, T feedforward_Nm = T(0)) noexcept {
     const T error = omega_ref_rad_s - omega_rad_s;
-    const T unclamped = kp_ * error + integral_;
+    const T unclamped = kp_ * error + integral_ + feedforward_Nm;
     const T output = std::clamp(unclamped, -limit_, limit_);
     const bool pushing_further =
         (unclamped > limit_ && error > T(0)) || (unclamped < -limit_ && error < T(0));

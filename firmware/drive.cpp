@@ -75,13 +75,15 @@ template <typename T>
 inline LawOutput<T> Drive<T>::law(const TickPlan<T>& plan, const Estimate<T>& e,
                                   T v_bus_V) noexcept {
   record_.law.speed_saturated = record_.law.flux_saturated = record_.law.iol_boundary = false;
+  record_.law.voltage_limited = false;
   if (plan.mode == Mode::off) return {};
   const control::InputDisk<T> feasible = limits_.feasible(e.x_input, v_bus_V);
   if (plan.mode == Mode::magnetizing) {
     return magnetizer_.step(e.x_input, plan.next, supervisor_.controlled_flux(), feasible);
   }
-  return supervisor_.law().step({e, plan.now, plan.next, plan.ahead, plan.stopping, feasible},
-                                record_.law);
+  return supervisor_.law().step(
+      {e, plan.now, plan.next, plan.ahead, plan.stopping, feasible, limits_.v_max_V(v_bus_V)},
+      record_.law);
 }
 
 template <typename T>

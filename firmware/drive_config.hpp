@@ -12,8 +12,9 @@ namespace imd::firmware {
 enum class ControllerKind : uint8_t {
   dsmc,  ///< paper 000: sliding modes on speed and rotor flux
   iol,   ///< paper 001: input-output linearization of torque and stator flux
+  ifoc,  ///< indirect field-oriented control: the classic drive's baseline
 };
-inline constexpr int kControllerCount = 2;
+inline constexpr int kControllerCount = 3;
 
 struct DriveConfig {
   double sample_period_s = 1e-4;  ///< control period delta
@@ -36,6 +37,10 @@ struct DriveConfig {
   double speed_loop_bandwidth_rad_s = 30.0;
   double torque_limit_Nm = 240.0;
   double flux_loop_time_constant_s = 0.01;
+
+  // The field-oriented controller (ifoc); 0: the rules of docs/ifoc.md.
+  double ifoc_current_bandwidth_rad_s = 0.0;
+  double ifoc_speed_bandwidth_rad_s = 0.0;
 
   // Control law.
   double max_accel_rad_s2 = std::numeric_limits<double>::infinity();  ///< speed reference ramp

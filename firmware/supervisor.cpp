@@ -88,7 +88,7 @@ TickPlan<T> Supervisor<T>::plan(uint64_t k, const Measurement<T>& m,
     if (machine_.state() == DriveState::magnetizing) {
       if (magnetizer_.magnetized(e.x, p.next, flux)) {
         machine_.go(DriveState::running, TransitionReason::magnetized, k);
-        law().start(magnetizer_.current_AB_A(e.x_input, p.next, flux));
+        law().start(e.x, magnetizer_.current_AB_A(e.x_input, p.next, flux));
       } else {
         p.mode = Mode::magnetizing;
       }

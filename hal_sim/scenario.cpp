@@ -155,7 +155,7 @@ Scenario load_scenario(const std::filesystem::path& path,
     r.fail("drive.sample_period_s",
            fmt::format("= {}: must be in [1e-6, 1e-2] s", s.sample_period_s));
   }
-  s.controller = r.choice("drive.controller", "dsmc", {"dsmc", "iol"});
+  s.controller = r.choice("drive.controller", "dsmc", {"dsmc", "iol", "ifoc"});
   const bool iol = s.controller == "iol";
   s.iol_period_s = r.positive("drive.iol_period_s", 1e-3);
   const double ratio = s.iol_period_s / s.sample_period_s;
@@ -168,6 +168,8 @@ Scenario load_scenario(const std::filesystem::path& path,
   s.speed_loop_bandwidth_rad_s = r.positive("drive.speed_loop_bandwidth_rad_s", 30.0);
   s.torque_limit_Nm = r.positive("drive.torque_limit_Nm", 240.0);
   s.flux_loop_time_constant_s = r.positive("drive.flux_loop_time_constant_s", 0.01);
+  s.ifoc_current_bandwidth_rad_s = r.non_negative("drive.ifoc_current_bandwidth_rad_s", 0.0);
+  s.ifoc_speed_bandwidth_rad_s = r.non_negative("drive.ifoc_speed_bandwidth_rad_s", 0.0);
   if (s.flux_loop_time_constant_s < 2.0 * s.iol_period_s) {  // keeps Kp below e (docs/iol.md)
     r.fail("drive.flux_loop_time_constant_s",
            fmt::format("= {}: must be >= 2 drive.iol_period_s", s.flux_loop_time_constant_s));

@@ -57,7 +57,7 @@ struct Scenario {
 
   // [drive]
   double sample_period_s = 1e-4;
-  std::string controller = "dsmc";   ///< "dsmc" (paper 000) or "iol" (paper 001)
+  std::string controller = "dsmc";  ///< "dsmc" (paper 000), "iol" (paper 001) or "ifoc"
   std::string precision = "double";  ///< control arithmetic: "double" or "float"
   double max_accel_rad_s2 = 0.0;     ///< speed reference ramp; inf: none
   /// Where the speed reference comes from: "profile" ([reference.speed]) or "can" (only from
@@ -78,6 +78,8 @@ struct Scenario {
   bool outer_speed_loop = false, outer_flux_loop = false;
   double speed_loop_bandwidth_rad_s = 30.0, torque_limit_Nm = 240.0;
   double flux_loop_time_constant_s = 0.01;
+  // [drive] for the ifoc controller; 0: the rules of docs/ifoc.md
+  double ifoc_current_bandwidth_rad_s = 0.0, ifoc_speed_bandwidth_rad_s = 0.0;
   double magnetized_fraction = 0.95;
   double magnetizing_current_A = 0.0;  ///< 0: the current that holds the flux target
 

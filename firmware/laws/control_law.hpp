@@ -24,6 +24,7 @@ struct LawInput {
   const Reference<T>& ahead;  ///< lookahead_ticks() ahead (the speed still next's)
   bool stopping;
   const control::InputDisk<T>& feasible;  ///< the inputs the voltage and current limits allow
+  T v_max_V;  ///< the stator voltage the modulation reaches (+inf without a voltage limit)
 };
 
 template <typename T>
@@ -46,6 +47,10 @@ struct LawDiagnostics {
   control::Vec2<T> i_held_AB_A = control::Vec2<T>::Zero();  ///< current assumed held now
   bool torque_limited = false;
   bool iol_boundary = false;  ///< the law ran this tick
+  // The field-oriented law.
+  T flux_ref_Wb = T(0);        ///< rotor-flux reference after field weakening
+  T slip_rad_s = T(0);         ///< electrical slip of its rotor-flux model
+  bool voltage_limited = false;  ///< this tick: its voltage was cut to the disk
 };
 
 template <typename T>
@@ -61,8 +66,13 @@ class ControlLaw {
   virtual bool follows_speed() const noexcept = 0;
   /// How far ahead the law looks into the references (LawInput::ahead), in ticks.
   virtual uint32_t lookahead_ticks() const noexcept { return 0; }
-  /// The drive starts running with this rotor-frame current (the magnetizing current).
-  virtual void start(const control::Vec2<T>& i_AB_A) noexcept { (void)i_AB_A; }
+  /// The drive starts running in state x (estimated, magnetized) with this rotor-frame current
+  /// commanded (the magnetizing current).
+  virtual void start(const control::RotorFrameState<T>& x,
+                     const control::Vec2<T>& i_AB_A) noexcept {
+    (void)x;
+    (void)i_AB_A;
+  }
   virtual LawOutput<T> step(const LawInput<T>& in, LawDiagnostics<T>& report) noexcept = 0;
 };
 

@@ -26,7 +26,11 @@ class IolLaw final : public ControlLaw<T> {
   uint32_t lookahead_ticks() const noexcept override {
     return static_cast<uint32_t>(stage_.ticks_per_period());
   }
-  void start(const control::Vec2<T>& i_AB_A) noexcept override { stage_.start(i_AB_A); }
+  void start(const control::RotorFrameState<T>& x,
+             const control::Vec2<T>& i_AB_A) noexcept override {
+    (void)x;
+    stage_.start(i_AB_A);
+  }
 
   LawOutput<T> step(const LawInput<T>& in, LawDiagnostics<T>& report) noexcept override {
     const IolTickResult<T> r = stage_.tick(in.e.x.flux_r_AB_Wb, in.e.x.omega_mech_rad_s, in.ahead);

@@ -13,6 +13,7 @@
 #include "firmware/drive_config.hpp"
 #include "firmware/laws/control_law.hpp"
 #include "firmware/laws/dsmc_law.hpp"
+#include "firmware/laws/ifoc_law.hpp"
 #include "firmware/laws/iol_law.hpp"
 #include "firmware/laws/law_context.hpp"
 #include "firmware/protocol/messages.hpp"
@@ -20,9 +21,9 @@
 namespace imd::firmware {
 
 template <typename T>
-using Laws = std::tuple<DsmcLaw<T>, IolLaw<T>>;
+using Laws = std::tuple<DsmcLaw<T>, IolLaw<T>, IfocLaw<T>>;
 
-/// The law of this name ("dsmc", "iol": the CAN protocol's value table, which the DBC
+/// The law of this name ("dsmc", "iol", "ifoc": the CAN protocol's value table, which the DBC
 /// carries); false for no such law. Construction and configuration only.
 inline bool controller_named(std::string_view name, ControllerKind& kind) noexcept {
   for (const protocol::ValueName& v : protocol::kControllerValues) {

@@ -97,7 +97,7 @@ inline constexpr ValueName kFaultValues[] = {
     {14, "emergency_stop"},
     {15, "enable_input"},
 };
-inline constexpr ValueName kControllerValues[] = {{0, "dsmc"}, {1, "iol"}};
+inline constexpr ValueName kControllerValues[] = {{0, "dsmc"}, {1, "iol"}, {2, "ifoc"}};
 inline constexpr ValueName kCommandResultValues[] = {
     {0, "accepted"},      {1, "wrong_length"}, {2, "bad_crc"},     {3, "repeated_counter"},
     {4, "stale_counter"}, {5, "out_of_range"}, {6, "not_allowed"}, {7, "unknown_message"},

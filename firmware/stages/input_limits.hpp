@@ -5,6 +5,7 @@
 /// reaches from the measured bus and the current limit (control/input_disk.hpp). Tick context
 /// except construction.
 #include <cmath>
+#include <limits>
 
 #include "control/frames.hpp"
 #include "control/input_disk.hpp"
@@ -54,12 +55,17 @@ class InputLimits {
         a22_(T(c.a22)),
         b2_(T(c.b2)) {}
 
+  /// The stator voltage modulus the modulation reaches from this bus (+inf without a limit).
+  T v_max_V(T v_bus_V) const noexcept {
+    return voltage_limited_ ? modulation_margin_ * control::svpwm_linear_limit_V(v_bus_V)
+                            : std::numeric_limits<T>::infinity();
+  }
+
   /// The rotor-frame inputs v~ allowed over the period that starts in state x.
   control::InputDisk<T> feasible(const control::RotorFrameState<T>& x, T v_bus_V) const noexcept {
     control::InputDisk<T> voltage, current;
     if (voltage_limited_) {
-      voltage = {-feedback_.compensation_AB_V(x),
-                 modulation_margin_ * control::svpwm_linear_limit_V(v_bus_V)};
+      voltage = {-feedback_.compensation_AB_V(x), v_max_V(v_bus_V)};
     }
     if (current_limited_) {
       current = {-(a21_ * x.flux_r_AB_Wb + a22_ * x.i_s_AB_A) / b2_, current_limit_A_ / b2_};

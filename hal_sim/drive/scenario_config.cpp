@@ -36,6 +36,8 @@ firmware::DriveConfig drive_config(const Scenario& s) {
   c.speed_loop_bandwidth_rad_s = s.speed_loop_bandwidth_rad_s;
   c.torque_limit_Nm = s.torque_limit_Nm;
   c.flux_loop_time_constant_s = s.flux_loop_time_constant_s;
+  c.ifoc_current_bandwidth_rad_s = s.ifoc_current_bandwidth_rad_s;
+  c.ifoc_speed_bandwidth_rad_s = s.ifoc_speed_bandwidth_rad_s;
   c.magnetized_fraction = s.magnetized_fraction;
   c.magnetizing_current_A = s.magnetizing_current_A;
   c.pwm_latency_ticks = s.pwm_latency_ticks;

@@ -153,7 +153,8 @@ const SimRow& TickObserver<T>::observe(double t_s, const PlantState& truth, doub
   row.v_bus_meas_V = rec.v_bus_V;
   row.u_alpha_cmd_V = rec.u_alphabeta_V.x();
   row.u_beta_cmd_V = rec.u_alphabeta_V.y();
-  row.saturated = rec.law.speed_saturated || rec.law.flux_saturated || rec.voltage_clipped;
+  row.saturated = rec.law.speed_saturated || rec.law.flux_saturated || rec.law.voltage_limited ||
+                  rec.voltage_clipped;
 
   const bool running = rec.state == firmware::DriveState::running;
   if (running_from_s_ < 0 && running) running_from_s_ = t_s;

@@ -24,7 +24,7 @@ using imd::firmware::ControllerKind;
 using imd::firmware::DriveConfig;
 
 // A new field must be written here too: these sizes fail the build until it is.
-static_assert(sizeof(DriveConfig) == 384, "DriveConfig changed: write its new fields below");
+static_assert(sizeof(DriveConfig) == 400, "DriveConfig changed: write its new fields below");
 static_assert(sizeof(imd::sim::SimBoardConfig) == 112, "SimBoardConfig changed: write it below");
 static_assert(sizeof(imd::control::MotorParameters) == 64, "MotorParameters changed");
 
@@ -115,8 +115,10 @@ void write_board(Writer& w, const imd::sim::SimBoardConfig& b) {
 
 void write_drive(Writer& w, const DriveConfig& c) {
   w.number("drive.sample_period_s", c.sample_period_s);
-  w.line("drive.controller", c.controller == ControllerKind::iol ? "ControllerKind::iol"
-                                                                 : "ControllerKind::dsmc");
+  const char* controller = c.controller == ControllerKind::iol    ? "ControllerKind::iol"
+                           : c.controller == ControllerKind::ifoc ? "ControllerKind::ifoc"
+                                                                  : "ControllerKind::dsmc";
+  w.line("drive.controller", controller);
   w.integer("drive.pwm_latency_ticks", c.pwm_latency_ticks);
   w.boolean("drive.compensate_latency", c.compensate_latency);
   w.number("drive.iol_period_s", c.iol_period_s);
@@ -126,6 +128,8 @@ void write_drive(Writer& w, const DriveConfig& c) {
   w.number("drive.speed_loop_bandwidth_rad_s", c.speed_loop_bandwidth_rad_s);
   w.number("drive.torque_limit_Nm", c.torque_limit_Nm);
   w.number("drive.flux_loop_time_constant_s", c.flux_loop_time_constant_s);
+  w.number("drive.ifoc_current_bandwidth_rad_s", c.ifoc_current_bandwidth_rad_s);
+  w.number("drive.ifoc_speed_bandwidth_rad_s", c.ifoc_speed_bandwidth_rad_s);
   w.number("drive.max_accel_rad_s2", c.max_accel_rad_s2);
   w.number("drive.speed_reaching_pole", c.speed_reaching_pole);
   w.number("drive.flux_reaching_pole", c.flux_reaching_pole);

@@ -1,0 +1,156 @@
+#pragma once
+/// Indirect field-oriented control (IFOC), the classic drive's law, as the baseline the papers'
+/// laws are measured against (docs/ifoc.md). Each period:
+///   1. the rotor-flux model (control/rotor_flux_model.hpp) advances with the measured current:
+///      flux modulus and slip angle from the controller's rotor time constant;
+///   2. a speed PI with inertia and friction feed-forward gives the torque;
+///   3. flux by the magnetizing current i_d = psi_ref / Lm, the flux reference lowered to what the
+///      voltage allows above base speed (control/field_weakening.hpp); torque by
+///      i_q = T / (3/2 p Lm/Lr psi_r); |i| within the current limit, d first;
+///   4. two PIs on the predicted current of the period the voltage acts on (the same latency
+///      compensation as the other laws), with pole-zero cancellation of the stator transient
+///      time constant, cross-coupling and back-EMF feed-forward, and anti-windup against the
+///      voltage disk: d has priority, and each integrator tracks the voltage that can act.
+/// Gains from control/ifoc_design.hpp. Works in the rotor-aligned frame AB of the drive: its
+/// output is the stator voltage there. Tick context except construction.
+#include <algorithm>
+#include <cmath>
+
+#include "control/field_weakening.hpp"
+#include "control/frames.hpp"
+#include "control/ifoc_design.hpp"
+#include "control/input_disk.hpp"
+#include "control/rotor_flux_model.hpp"
+#include "control/speed_pi.hpp"
+
+namespace imd::control {
+
+template <typename T>
+struct IfocInput {
+  Vec2<T> i_now_AB_A = Vec2<T>::Zero();    ///< stator current at this tick
+  Vec2<T> i_input_AB_A = Vec2<T>::Zero();  ///< predicted at the start of the input's period
+  T omega_mech_rad_s = T(0);               ///< speed at the start of the input's period
+  T omega_ref_rad_s = T(0);                ///< speed reference at that step
+  T omega_ref_next_rad_s = T(0);           ///< and one step later
+  T flux_ref_Wb = T(0);                    ///< rotor-flux modulus wanted (below base speed)
+  InputDisk<T> u_feasible_AB_V;            ///< stator voltages allowed over the period
+  T v_max_V = T(0);                        ///< the voltage disk's radius (field weakening)
+};
+
+template <typename T>
+struct IfocOutput {
+  Vec2<T> u_AB_V = Vec2<T>::Zero();      ///< stator voltage, rotor frame
+  Vec2<T> i_ref_AB_A = Vec2<T>::Zero();  ///< current reference, rotor frame
+  Vec2<T> i_ref_dq_A = Vec2<T>::Zero();  ///< current reference, flux frame
+  T torque_ref_Nm = T(0);                ///< from the speed loop
+  T torque_cmd_Nm = T(0);                ///< after the current limit
+  T flux_ref_Wb = T(0);                  ///< after field weakening
+  bool torque_limited = false;           ///< the current limit trimmed the torque
+  bool voltage_limited = false;          ///< the PI voltage was outside the disk
+};
+
+template <typename T>
+class Ifoc {
+ public:
+  explicit Ifoc(const IfocGains& g) noexcept
+      : flux_model_(g.rotor_flux_decay, g.alpha_per_s, g.Lm_H, g.sample_period_s, g.min_flux_Wb),
+        speed_pi_(g.speed),
+        kp_(T(g.current_kp_V_per_A)),
+        ki_(T(g.current_ki_V_per_A)),
+        sigma_(T(g.sigma_H)),
+        sigma_gamma_(T(g.sigma_H * g.gamma_per_s)),
+        rotor_emf_(T(g.Lm_over_Lr * g.alpha_per_s)),
+        Lm_over_Lr_(T(g.Lm_over_Lr)),
+        Lm_(T(g.Lm_H)),
+        kt_(T(g.torque_constant_Nm_per_Wb_A)),
+        p_(T(g.pole_pairs)),
+        J_over_T_(T(g.J_kgm2 / g.sample_period_s)),
+        friction_(T(g.friction_Nms)),
+        i_limit_(T(g.current_limit_A)),
+        min_flux_(T(g.min_flux_Wb)),
+        fw_share_(T(g.field_weakening_voltage_share)),
+        fw_motor_{T(g.Rs_Ohm), T(g.Ls_H), T(g.sigma_H), T(g.Lm_H)},
+        latency_ticks_(g.latency_ticks) {}
+
+  /// Starts on a magnetized motor: the rotor flux (rotor frame) and the current flowing.
+  void start(const Vec2<T>& flux_r_AB_Wb, const Vec2<T>& i_AB_A) noexcept {
+    const T flux = flux_r_AB_Wb.norm();
+    const T angle = flux > min_flux_ ? std::atan2(flux_r_AB_Wb.y(), flux_r_AB_Wb.x())
+                                     : std::atan2(i_AB_A.y(), i_AB_A.x());
+    flux_model_.reset(flux, angle);
+    const Vec2<T> i_dq = flux_model_.frame().apply_inverse(i_AB_A);
+    // Bumpless: the integrators hold the voltage of the steady state the motor is in.
+    integral_V_ = sigma_gamma_ * i_dq;
+    i_q_ref_A_ = T(0);
+    speed_pi_.reset();
+  }
+
+  IfocOutput<T> step(const IfocInput<T>& in) noexcept {
+    IfocOutput<T> out;
+    flux_model_.advance(flux_model_.frame().apply_inverse(in.i_now_AB_A));
+    // The frame of the input's period (the latency's ticks after this one).
+    const Rotation<T> frame = flux_model_.frame_ahead(latency_ticks_ - 1);
+    const Vec2<T> i_dq = frame.apply_inverse(in.i_input_AB_A);
+    const T flux = std::max(flux_model_.flux_Wb(), min_flux_);
+    const T omega_e = p_ * in.omega_mech_rad_s + flux_model_.slip_rad_s();
+
+    // Flux: the reference, or what the voltage allows above base speed.
+    const T flux_limit = voltage_limited_flux_Wb(fw_motor_, omega_e, i_q_ref_A_,
+                                                 fw_share_ * in.v_max_V);
+    out.flux_ref_Wb = std::max(std::min(in.flux_ref_Wb, flux_limit), min_flux_);
+    const T i_d_ref = std::min(out.flux_ref_Wb / Lm_, i_limit_);
+
+    // Torque: speed PI with feed-forward, then the current left beside i_d.
+    const T feedforward = J_over_T_ * (in.omega_ref_next_rad_s - in.omega_ref_rad_s) +
+                          friction_ * in.omega_ref_next_rad_s;
+    out.torque_ref_Nm = speed_pi_.step(in.omega_ref_rad_s, in.omega_mech_rad_s, feedforward);
+    const T i_q_max = std::sqrt(std::max(i_limit_ * i_limit_ - i_d_ref * i_d_ref, T(0)));
+    const T i_q_wanted = out.torque_ref_Nm / (kt_ * flux);
+    i_q_ref_A_ = std::clamp(i_q_wanted, -i_q_max, i_q_max);
+    out.torque_limited = i_q_ref_A_ != i_q_wanted;
+    if (out.torque_limited) speed_pi_.undo_last_integration();
+    out.torque_cmd_Nm = kt_ * flux * i_q_ref_A_;
+    out.i_ref_dq_A = Vec2<T>(i_d_ref, i_q_ref_A_);
+
+    // Current PIs with feed-forward of the cross-coupling, the rotor's EMF and its flux decay.
+    const Vec2<T> error = out.i_ref_dq_A - i_dq;
+    const Vec2<T> feedforward_V(-sigma_ * omega_e * i_dq.y() - rotor_emf_ * flux,
+                                sigma_ * omega_e * i_dq.x() + p_ * in.omega_mech_rad_s *
+                                                                  Lm_over_Lr_ * flux);
+    const Vec2<T> u_dq = kp_ * error + integral_V_ + feedforward_V;
+    const Vec2<T> u_held =
+        limit_d_first(u_dq, frame.apply_inverse(in.u_feasible_AB_V.center_V), in.u_feasible_AB_V);
+    out.voltage_limited = u_held != u_dq;
+    // Tracking anti-windup: the integrator takes what the disk cut off.
+    integral_V_ += ki_ * error + (u_held - u_dq);
+    out.u_AB_V = frame.apply(u_held);
+    out.i_ref_AB_A = frame.apply(out.i_ref_dq_A);
+    return out;
+  }
+
+  const RotorFluxModel<T>& flux_model() const noexcept { return flux_model_; }
+  const SpeedPi<T>& speed_pi() const noexcept { return speed_pi_; }
+
+ private:
+  /// The point of the disk (centre `c` in the flux frame) that keeps u_d if it can, then as
+  /// much of u_q as is left.
+  static Vec2<T> limit_d_first(const Vec2<T>& u, const Vec2<T>& c,
+                               const InputDisk<T>& disk) noexcept {
+    if (disk.unlimited()) return u;
+    const T r = disk.radius_V > T(0) ? disk.radius_V : T(0);
+    const T d = std::clamp(u.x() - c.x(), -r, r);
+    const T q_room = std::sqrt(std::max(r * r - d * d, T(0)));
+    return Vec2<T>(c.x() + d, c.y() + std::clamp(u.y() - c.y(), -q_room, q_room));
+  }
+
+  RotorFluxModel<T> flux_model_;
+  SpeedPi<T> speed_pi_;
+  T kp_, ki_, sigma_, sigma_gamma_, rotor_emf_, Lm_over_Lr_, Lm_, kt_, p_;
+  T J_over_T_, friction_, i_limit_, min_flux_, fw_share_;
+  FieldWeakeningMotor<T> fw_motor_;
+  int latency_ticks_;
+  Vec2<T> integral_V_ = Vec2<T>::Zero();
+  T i_q_ref_A_ = T(0);  ///< the last torque current (the field-weakening limit's load)
+};
+
+}  // namespace imd::control
