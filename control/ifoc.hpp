@@ -3,7 +3,8 @@
 /// laws are measured against (docs/ifoc.md). Each period:
 ///   1. the rotor-flux model (control/rotor_flux_model.hpp) advances with the measured current:
 ///      flux modulus and slip angle from the controller's rotor time constant;
-///   2. a speed PI with inertia and friction feed-forward gives the torque;
+///   2. a speed PI with inertia and friction feed-forward gives the torque; its integrator
+///      stops while the current limit or the voltage limit keeps that torque from the motor;
 ///   3. flux by the magnetizing current i_d = psi_ref / Lm, the flux reference lowered to what the
 ///      voltage allows above base speed (control/field_weakening.hpp); torque by
 ///      i_q = T / (3/2 p Lm/Lr psi_r); |i| within the current limit, d first;
@@ -17,6 +18,7 @@
 #include <cmath>
 
 #include "control/field_weakening.hpp"
+#include "control/flux_frame_current_loop.hpp"
 #include "control/frames.hpp"
 #include "control/ifoc_design.hpp"
 #include "control/input_disk.hpp"
@@ -55,12 +57,7 @@ class Ifoc {
   explicit Ifoc(const IfocGains& g) noexcept
       : flux_model_(g.rotor_flux_decay, g.alpha_per_s, g.Lm_H, g.sample_period_s, g.min_flux_Wb),
         speed_pi_(g.speed),
-        kp_(T(g.current_kp_V_per_A)),
-        ki_(T(g.current_ki_V_per_A)),
-        sigma_(T(g.sigma_H)),
-        sigma_gamma_(T(g.sigma_H * g.gamma_per_s)),
-        rotor_emf_(T(g.Lm_over_Lr * g.alpha_per_s)),
-        Lm_over_Lr_(T(g.Lm_over_Lr)),
+        current_loop_(g),
         Lm_(T(g.Lm_H)),
         kt_(T(g.torque_constant_Nm_per_Wb_A)),
         p_(T(g.pole_pairs)),
@@ -79,9 +76,7 @@ class Ifoc {
                                      : std::atan2(i_AB_A.y(), i_AB_A.x());
     flux_model_.reset(flux, angle);
     const Vec2<T> i_dq = flux_model_.frame().apply_inverse(i_AB_A);
-    // Bumpless: the integrators hold the voltage of the steady state the motor is in.
-    integral_V_ = sigma_gamma_ * i_dq;
-    i_q_ref_A_ = T(0);
+    current_loop_.reset(i_dq);
     speed_pi_.reset();
   }
 
@@ -94,9 +89,11 @@ class Ifoc {
     const T flux = std::max(flux_model_.flux_Wb(), min_flux_);
     const T omega_e = p_ * in.omega_mech_rad_s + flux_model_.slip_rad_s();
 
-    // Flux: the reference, or what the voltage allows above base speed.
-    const T flux_limit = voltage_limited_flux_Wb(fw_motor_, omega_e, i_q_ref_A_,
-                                                 fw_share_ * in.v_max_V);
+    // Flux: the reference, or what the voltage allows above base speed at no load. Not at the
+    // present load: less flux asks for more torque current, which would lower the limit again
+    // until the flux collapsed; the share of the disk left over covers the load's voltage.
+    const T flux_limit =
+        voltage_limited_flux_Wb(fw_motor_, omega_e, T(0), fw_share_ * in.v_max_V);
     out.flux_ref_Wb = std::max(std::min(in.flux_ref_Wb, flux_limit), min_flux_);
     const T i_d_ref = std::min(out.flux_ref_Wb / Lm_, i_limit_);
 
@@ -106,24 +103,26 @@ class Ifoc {
     out.torque_ref_Nm = speed_pi_.step(in.omega_ref_rad_s, in.omega_mech_rad_s, feedforward);
     const T i_q_max = std::sqrt(std::max(i_limit_ * i_limit_ - i_d_ref * i_d_ref, T(0)));
     const T i_q_wanted = out.torque_ref_Nm / (kt_ * flux);
-    i_q_ref_A_ = std::clamp(i_q_wanted, -i_q_max, i_q_max);
-    out.torque_limited = i_q_ref_A_ != i_q_wanted;
+    const T i_q_ref = std::clamp(i_q_wanted, -i_q_max, i_q_max);
+    out.torque_limited = i_q_ref != i_q_wanted;
     if (out.torque_limited) speed_pi_.undo_last_integration();
-    out.torque_cmd_Nm = kt_ * flux * i_q_ref_A_;
-    out.i_ref_dq_A = Vec2<T>(i_d_ref, i_q_ref_A_);
+    out.torque_cmd_Nm = kt_ * flux * i_q_ref;
+    out.i_ref_dq_A = Vec2<T>(i_d_ref, i_q_ref);
 
-    // Current PIs with feed-forward of the cross-coupling, the rotor's EMF and its flux decay.
-    const Vec2<T> error = out.i_ref_dq_A - i_dq;
-    const Vec2<T> feedforward_V(-sigma_ * omega_e * i_dq.y() - rotor_emf_ * flux,
-                                sigma_ * omega_e * i_dq.x() + p_ * in.omega_mech_rad_s *
-                                                                  Lm_over_Lr_ * flux);
-    const Vec2<T> u_dq = kp_ * error + integral_V_ + feedforward_V;
-    const Vec2<T> u_held =
-        limit_d_first(u_dq, frame.apply_inverse(in.u_feasible_AB_V.center_V), in.u_feasible_AB_V);
-    out.voltage_limited = u_held != u_dq;
-    // Tracking anti-windup: the integrator takes what the disk cut off.
-    integral_V_ += ki_ * error + (u_held - u_dq);
-    out.u_AB_V = frame.apply(u_held);
+    CurrentLoopInput<T> loop;
+    loop.i_ref_dq_A = out.i_ref_dq_A;
+    loop.i_dq_A = i_dq;
+    loop.omega_e_rad_s = omega_e;
+    loop.omega_mech_rad_s = in.omega_mech_rad_s;
+    loop.flux_Wb = flux;
+    loop.u_feasible_dq_V = {frame.apply_inverse(in.u_feasible_AB_V.center_V),
+                            in.u_feasible_AB_V.radius_V};
+    const CurrentLoopOutput<T> u = current_loop_.step(loop);
+    out.voltage_limited = u.voltage_limited;
+    // The torque asked for cannot be imposed with the voltage there is: the speed integrator
+    // must not wind up against the voltage limit either.
+    if (u.voltage_limited && !out.torque_limited) speed_pi_.undo_last_integration();
+    out.u_AB_V = frame.apply(u.u_dq_V);
     out.i_ref_AB_A = frame.apply(out.i_ref_dq_A);
     return out;
   }
@@ -132,25 +131,13 @@ class Ifoc {
   const SpeedPi<T>& speed_pi() const noexcept { return speed_pi_; }
 
  private:
-  /// The point of the disk (centre `c` in the flux frame) that keeps u_d if it can, then as
-  /// much of u_q as is left.
-  static Vec2<T> limit_d_first(const Vec2<T>& u, const Vec2<T>& c,
-                               const InputDisk<T>& disk) noexcept {
-    if (disk.unlimited()) return u;
-    const T r = disk.radius_V > T(0) ? disk.radius_V : T(0);
-    const T d = std::clamp(u.x() - c.x(), -r, r);
-    const T q_room = std::sqrt(std::max(r * r - d * d, T(0)));
-    return Vec2<T>(c.x() + d, c.y() + std::clamp(u.y() - c.y(), -q_room, q_room));
-  }
-
   RotorFluxModel<T> flux_model_;
   SpeedPi<T> speed_pi_;
-  T kp_, ki_, sigma_, sigma_gamma_, rotor_emf_, Lm_over_Lr_, Lm_, kt_, p_;
+  FluxFrameCurrentLoop<T> current_loop_;
+  T Lm_, kt_, p_;
   T J_over_T_, friction_, i_limit_, min_flux_, fw_share_;
   FieldWeakeningMotor<T> fw_motor_;
   int latency_ticks_;
-  Vec2<T> integral_V_ = Vec2<T>::Zero();
-  T i_q_ref_A_ = T(0);  ///< the last torque current (the field-weakening limit's load)
 };
 
 }  // namespace imd::control

@@ -24,7 +24,7 @@ constexpr CommandWord kWords[] = {
     {"clear-faults", CommandKind::clear_faults, nullptr},
     {"set-speed", CommandKind::set_speed, "RAD_S"},
     {"set-flux", CommandKind::set_flux, "WB2"},
-    {"select-controller", CommandKind::select_controller, "dsmc|iol"},
+    {"select-controller", CommandKind::select_controller, "dsmc|iol|ifoc"},
     {"set-telemetry-rate", CommandKind::set_telemetry_rate, "HZ"},
 };
 
