@@ -31,35 +31,39 @@ const char* type_name(const toml::node& node) {
   }
 }
 
-const toml::node& require_key(const toml::table& motor, std::string_view key,
-                              std::string_view source) {
+/// Where a key is, for messages: the file and the table ("motor" or "plant").
+struct Place {
+  std::string_view source, table;
+};
+
+const toml::node& require_key(const toml::table& motor, std::string_view key, Place at) {
   const toml::node* node = motor.get(key);
   if (node == nullptr) {
-    throw ConfigError(fmt::format("{}: missing key motor.{}", source, key));
+    throw ConfigError(fmt::format("{}: missing key {}.{}", at.source, at.table, key));
   }
   return *node;
 }
 
-double require_number(const toml::table& motor, std::string_view key, std::string_view source) {
-  const toml::node& node = require_key(motor, key, source);
+double require_number(const toml::table& motor, std::string_view key, Place at) {
+  const toml::node& node = require_key(motor, key, at);
   if (const auto* real = node.as_floating_point()) return real->get();
   if (const auto* integer = node.as_integer()) return static_cast<double>(integer->get());
-  throw ConfigError(
-      fmt::format("{}: motor.{} must be a number, got {}", source, key, type_name(node)));
+  throw ConfigError(fmt::format("{}: {}.{} must be a number, got {}", at.source, at.table, key,
+                                type_name(node)));
 }
 
-int require_integer(const toml::table& motor, std::string_view key, std::string_view source) {
-  const toml::node& node = require_key(motor, key, source);
+int require_integer(const toml::table& motor, std::string_view key, Place at) {
+  const toml::node& node = require_key(motor, key, at);
   if (const auto* integer = node.as_integer()) {
     const int64_t value = integer->get();
     if (value < 1 || value > 64) {
-      throw ConfigError(
-          fmt::format("{}: motor.{} = {}: must be an integer in 1..64", source, key, value));
+      throw ConfigError(fmt::format("{}: {}.{} = {}: must be an integer in 1..64", at.source,
+                                    at.table, key, value));
     }
     return static_cast<int>(value);
   }
-  throw ConfigError(
-      fmt::format("{}: motor.{} must be an integer, got {}", source, key, type_name(node)));
+  throw ConfigError(fmt::format("{}: {}.{} must be an integer, got {}", at.source, at.table, key,
+                                type_name(node)));
 }
 
 }  // namespace
@@ -81,26 +85,30 @@ toml::table parse_toml_file(const std::filesystem::path& path) {
   }
 }
 
-control::MotorParameters parse_motor_table(const toml::table& document, std::string_view source) {
-  const toml::node* motor_node = document.get("motor");
-  if (motor_node == nullptr) throw ConfigError(fmt::format("{}: missing table [motor]", source));
+control::MotorParameters parse_motor_table(const toml::table& document, std::string_view source,
+                                           std::string_view table) {
+  const toml::node* motor_node = document.get(table);
+  if (motor_node == nullptr) {
+    throw ConfigError(fmt::format("{}: missing table [{}]", source, table));
+  }
   const toml::table* motor = motor_node->as_table();
   if (motor == nullptr) {
     throw ConfigError(
-        fmt::format("{}: motor must be a table, got {}", source, type_name(*motor_node)));
+        fmt::format("{}: {} must be a table, got {}", source, table, type_name(*motor_node)));
   }
+  const Place at{source, table};
   control::MotorParameters p;
-  p.Rs_Ohm = require_number(*motor, "Rs_Ohm", source);
-  p.Ls_H = require_number(*motor, "Ls_H", source);
-  p.Lm_H = require_number(*motor, "Lm_H", source);
-  p.Rr_Ohm = require_number(*motor, "Rr_Ohm", source);
-  p.Lr_H = require_number(*motor, "Lr_H", source);
-  p.J_kgm2 = require_number(*motor, "J_kgm2", source);
-  p.pole_pairs = require_integer(*motor, "pole_pairs", source);
-  p.friction_Nms = require_number(*motor, "friction_Nms", source);
+  p.Rs_Ohm = require_number(*motor, "Rs_Ohm", at);
+  p.Ls_H = require_number(*motor, "Ls_H", at);
+  p.Lm_H = require_number(*motor, "Lm_H", at);
+  p.Rr_Ohm = require_number(*motor, "Rr_Ohm", at);
+  p.Lr_H = require_number(*motor, "Lr_H", at);
+  p.J_kgm2 = require_number(*motor, "J_kgm2", at);
+  p.pole_pairs = require_integer(*motor, "pole_pairs", at);
+  p.friction_Nms = require_number(*motor, "friction_Nms", at);
   if (const auto problem = control::find_invalid_parameter(p)) {
-    throw ConfigError(
-        fmt::format("{}: motor.{} = {}: {}", source, problem->key, problem->value, problem->rule));
+    throw ConfigError(fmt::format("{}: {}.{} = {}: {}", source, table, problem->key,
+                                  problem->value, problem->rule));
   }
   return p;
 }

@@ -18,9 +18,11 @@ namespace imd::sim {
 /// the key and the value on a syntax error, a missing key, a wrong type or an invalid value.
 control::MotorParameters load_motor_file(const std::filesystem::path& path);
 
-/// Reads and validates the [motor] table of an already parsed document. `source` names the
-/// document in error messages.
-control::MotorParameters parse_motor_table(const toml::table& document, std::string_view source);
+/// Reads and validates the [motor] table (or another of the same keys, such as a scenario's
+/// completed [plant]) of an already parsed document. `source` names the document in error
+/// messages.
+control::MotorParameters parse_motor_table(const toml::table& document, std::string_view source,
+                                           std::string_view table = "motor");
 
 /// Parses a TOML file, turning a syntax error into a ConfigError with file, line and column.
 toml::table parse_toml_file(const std::filesystem::path& path);

@@ -121,6 +121,25 @@ void read_load_like(Reader& r, const std::string& prefix, LoadProfile& p) {
   }
 }
 
+/// The simulated motor: [motor] with the keys [plant] changes (any motor key, nothing else).
+control::MotorParameters parse_plant_table(const toml::table& doc, const std::string& source) {
+  const toml::node* plant = doc.get("plant");
+  if (plant == nullptr) return parse_motor_table(doc, source);
+  if (!plant->is_table()) throw ConfigError(fmt::format("{}: plant must be a table", source));
+  toml::table completed = *doc.get("motor")->as_table();  // parse_motor_table checked it
+  for (auto&& [key, value] : *plant->as_table()) {
+    if (!kMotorKeys.count(std::string(key.str())) && key.str() != "name") {
+      throw ConfigError(fmt::format("{}: unknown key plant.{} (a motor key: Rs_Ohm, Ls_H, Lm_H, "
+                                    "Rr_Ohm, Lr_H, J_kgm2, pole_pairs, friction_Nms)",
+                                    source, key.str()));
+    }
+    completed.insert_or_assign(key, value);
+  }
+  toml::table holder;
+  holder.insert("plant", std::move(completed));
+  return parse_motor_table(holder, source, "plant");
+}
+
 }  // namespace
 
 Scenario load_scenario(const std::filesystem::path& path,
@@ -147,8 +166,10 @@ Scenario load_scenario(const std::filesystem::path& path,
   Scenario s;
   s.source = source;
   s.motor = parse_motor_table(doc, source);
+  s.plant = parse_plant_table(doc, source);
   Reader r(doc, source);
   r.accept_table("motor");
+  r.accept_table("plant");
 
   s.sample_period_s = r.positive("drive.sample_period_s", 1e-4);
   if (s.sample_period_s < 1e-6 || s.sample_period_s > 1e-2) {

@@ -53,7 +53,9 @@ struct ProtectionSettings {
 
 struct Scenario {
   std::string source;  ///< file name, for messages and the summary
-  control::MotorParameters motor;
+  control::MotorParameters motor;  ///< what the controller knows: [motor] or motor_file
+  /// The simulated motor: [motor] changed by the keys of [plant] (the same without it).
+  control::MotorParameters plant;
 
   // [drive]
   double sample_period_s = 1e-4;

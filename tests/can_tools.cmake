@@ -45,7 +45,7 @@ if(TARGET drive_monitor)
   imd_monitor_test(drive_monitor_send_unrepresentable 2 "set-speed: 3e6 cannot be represented"
                    send --can vcan9 --node 1 set-speed 3e6)
   imd_monitor_test(drive_monitor_send_unknown_controller 2
-                   "unknown controller 'pid' \\(known: dsmc, iol\\)"
+                   "unknown controller 'pid' \\(known: dsmc, iol, ifoc\\)"
                    send --can vcan9 --node 1 select-controller pid)
   imd_monitor_test(drive_monitor_send_bad_rate 2 "set-telemetry-rate: 5 must be a whole number of Hz"
                    send --can vcan9 --node 1 set-telemetry-rate 5)

@@ -22,7 +22,7 @@ import sys
 
 SKIP = {"seed000_hil"}  # the real-time scenario: CAN-commanded, no profile to run here
 NOT_COMPARED = {"wall_time_s", "tick_exec_ns_mean", "tick_exec_ns_max", "realtime_factor",
-                "stage_ns", "scenario", "source",
+                "stage_ns", "scenario", "source", "controller", "motor", "plant",
                 "simulated_s_per_wall_s"}
 DOUBLE_TOLERANCE = 1e-9
 

@@ -124,7 +124,7 @@ int run(const Options& o, const imd::sim::Scenario& s, imd::hal::QueuedCanBus* c
   config.fault_output_line = lines.fault;
   config.timing_output_line = lines.timing;
 
-  sim::SimBoard board(s.motor, sim::board_config(s));
+  sim::SimBoard board(s.plant, sim::board_config(s));
   sim::prepare_board(board, s);
   hal::RealtimeOptions timing;
   timing.period_ns = static_cast<uint32_t>(std::lround(s.sample_period_s * 1e9));

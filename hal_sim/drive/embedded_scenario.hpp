@@ -14,7 +14,8 @@ namespace imd::sim {
 
 struct EmbeddedScenario {
   const char* name = "";  ///< the scenario file's stem, e.g. "seed000_realistic"
-  control::MotorParameters motor;
+  control::MotorParameters motor;  ///< the controller's
+  control::MotorParameters plant;  ///< the simulated motor's
   SimBoardConfig board;
   firmware::DriveConfig drive;
   ScenarioProfiles references;

@@ -86,10 +86,10 @@ void prepare_board(SimBoard& board, const Scenario& s) {
   PlantState start;
   start.theta_mech_rad = s.initial_theta_mech_rad;
   const auto rotor =
-      control::Rotation<double>::from_angle(s.motor.pole_pairs * s.initial_theta_mech_rad);
+      control::Rotation<double>::from_angle(s.plant.pole_pairs * s.initial_theta_mech_rad);
   const double flux_Wb = std::sqrt(s.initial_flux2_Wb2);
   start.flux_r_alphabeta_Wb = rotor.apply(Vec2(flux_Wb, 0.0));
-  start.i_s_alphabeta_A = rotor.apply(Vec2(flux_Wb / s.motor.Lm_H, 0.0));
+  start.i_s_alphabeta_A = rotor.apply(Vec2(flux_Wb / s.plant.Lm_H, 0.0));
   board.plant().set_state(start);
 }
 

@@ -23,7 +23,7 @@ namespace {
 
 template <typename T>
 Summary run(const Scenario& s, const RunCallbacks& callbacks) {
-  SimBoard board(s.motor, sim::board_config(s));
+  SimBoard board(s.plant, sim::board_config(s));
   sim::prepare_board(board, s);
   const sim::ScenarioReferences<T> references(s);
   const firmware::DriveConfig config = sim::drive_config(s);

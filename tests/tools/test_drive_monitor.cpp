@@ -195,7 +195,7 @@ TEST(drive_monitor_send, RejectsBadCommandsLocally) {
       {"set-speed", "3e6", "set-speed: 3e6 cannot be represented: speed_ref_rad_s spans"},
       {"set-flux", "-0.5", "set-flux: -0.5 cannot be represented"},
       {"set-flux", "0", "set-flux: 0 must be > 0 Wb^2"},
-      {"select-controller", "pid", "unknown controller 'pid' (known: dsmc, iol)"},
+      {"select-controller", "pid", "unknown controller 'pid' (known: dsmc, iol, ifoc)"},
       {"set-telemetry-rate", "5", "must be a whole number of Hz in 10..1000"},
       {"set-telemetry-rate", "100.5", "must be a whole number of Hz in 10..1000"},
   };

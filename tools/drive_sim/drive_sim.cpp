@@ -89,6 +89,12 @@ const Column kColumns[] = {
 };
 #undef IMD_COLUMN
 
+nlohmann::ordered_json motor_json(const imd::control::MotorParameters& m) {
+  return {{"Rs_Ohm", m.Rs_Ohm}, {"Ls_H", m.Ls_H},     {"Lm_H", m.Lm_H},
+          {"Rr_Ohm", m.Rr_Ohm}, {"Lr_H", m.Lr_H},     {"J_kgm2", m.J_kgm2},
+          {"pole_pairs", m.pole_pairs}, {"friction_Nms", m.friction_Nms}};
+}
+
 nlohmann::ordered_json summary_json(const imd::sim::Scenario& s, const imd::sim::Summary& r) {
   nlohmann::ordered_json faults = nlohmann::ordered_json::array();
   auto time = [](double t_s) {  // NaN: it did not happen
@@ -107,7 +113,10 @@ nlohmann::ordered_json summary_json(const imd::sim::Scenario& s, const imd::sim:
     stages[imd::firmware::kStageNames[i]] = r.stage_ns_mean[i];
   }
   return {{"scenario", s.source},
+          {"controller", s.controller},
           {"precision", s.precision},
+          {"motor", motor_json(s.motor)},  // what the controller was given
+          {"plant", motor_json(s.plant)},  // what it ran
           {"settle_s", s.settle_s},
           {"speed_rms_err_rad_s", r.speed_rms_err_rad_s},
           {"speed_max_err_rad_s", r.speed_max_err_rad_s},

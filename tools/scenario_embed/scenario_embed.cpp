@@ -83,15 +83,15 @@ void write_speed(Writer& w, const std::string& p, const imd::sim::SpeedProfile& 
   }
 }
 
-void write_motor(Writer& w, const imd::control::MotorParameters& m) {
-  w.number("motor.Rs_Ohm", m.Rs_Ohm);
-  w.number("motor.Ls_H", m.Ls_H);
-  w.number("motor.Lm_H", m.Lm_H);
-  w.number("motor.Rr_Ohm", m.Rr_Ohm);
-  w.number("motor.Lr_H", m.Lr_H);
-  w.number("motor.J_kgm2", m.J_kgm2);
-  w.integer("motor.pole_pairs", m.pole_pairs);
-  w.number("motor.friction_Nms", m.friction_Nms);
+void write_motor(Writer& w, const std::string& p, const imd::control::MotorParameters& m) {
+  w.number(p + ".Rs_Ohm", m.Rs_Ohm);
+  w.number(p + ".Ls_H", m.Ls_H);
+  w.number(p + ".Lm_H", m.Lm_H);
+  w.number(p + ".Rr_Ohm", m.Rr_Ohm);
+  w.number(p + ".Lr_H", m.Lr_H);
+  w.number(p + ".J_kgm2", m.J_kgm2);
+  w.integer(p + ".pole_pairs", m.pole_pairs);
+  w.number(p + ".friction_Nms", m.friction_Nms);
 }
 
 void write_board(Writer& w, const imd::sim::SimBoardConfig& b) {
@@ -187,7 +187,6 @@ std::string embed(const imd::sim::Scenario& s, const std::string& name,
   };
   // What the processor-in-the-loop runner does not do: it measures the DSMC's metrics of a
   // profile run, with the board's own sensors.
-  if (s.controller != "dsmc") refuse("controller must be \"dsmc\" (the runner measures its metrics)");
   if (s.command_source != "profile") refuse("drive.command_source must be \"profile\"");
   if (s.ideal_sensors) refuse("sensors.ideal must be false (an MCU has no oracle)");
   if (s.inner_feedback != imd::sim::InnerFeedback::digital || s.current_fed) {
@@ -195,14 +194,15 @@ std::string embed(const imd::sim::Scenario& s, const std::string& name,
   }
   if (!s.faults.empty() || !s.can_commands.empty()) refuse("faults and can_commands are not run");
 
-  imd::sim::SimBoard board(s.motor, imd::sim::board_config(s));
+  imd::sim::SimBoard board(s.plant, imd::sim::board_config(s));
   imd::sim::prepare_board(board, s);
   const imd::sim::PlantState& x0 = board.plant().state();
 
   std::string body;
   Writer w(body);
   w.line("name", fmt::format("\"{}\"", name));
-  write_motor(w, s.motor);
+  write_motor(w, "motor", s.motor);
+  write_motor(w, "plant", s.plant);
   write_board(w, imd::sim::board_config(s));
   write_drive(w, imd::sim::drive_config(s));
   write_speed(w, "references.speed", s.speed);

@@ -58,7 +58,7 @@ void wait_for_tick(const cm::TwoStageTick& timer) noexcept {
 }
 
 int run(const sim::EmbeddedScenario& s, cm::CmsdkUart& console) {
-  static sim::SimBoard board(s.motor, s.board);
+  static sim::SimBoard board(s.plant, s.board);
   board.set_load_profile(s.load);
   board.plant().set_state(s.initial_state);
   static sim::LookaheadReferences<float> references(s.references, s.drive.sample_period_s);
