@@ -89,11 +89,12 @@ class Ifoc {
     const T flux = std::max(flux_model_.flux_Wb(), min_flux_);
     const T omega_e = p_ * in.omega_mech_rad_s + flux_model_.slip_rad_s();
 
-    // Flux: the reference, or what the voltage allows above base speed at no load. Not at the
-    // present load: less flux asks for more torque current, which would lower the limit again
-    // until the flux collapsed; the share of the disk left over covers the load's voltage.
-    const T flux_limit =
-        voltage_limited_flux_Wb(fw_motor_, omega_e, T(0), fw_share_ * in.v_max_V);
+    // Flux: the reference, or what the voltage allows above base speed with the torque current
+    // flowing, but never less than the flux of the most torque per volt (less flux would ask
+    // for more current and lower the limit again).
+    const T v_fw = fw_share_ * in.v_max_V;
+    const T flux_limit = std::max(voltage_limited_flux_Wb(fw_motor_, omega_e, i_dq.y(), v_fw),
+                                  max_torque_per_volt_flux_Wb(fw_motor_, omega_e, v_fw));
     out.flux_ref_Wb = std::max(std::min(in.flux_ref_Wb, flux_limit), min_flux_);
     const T i_d_ref = std::min(out.flux_ref_Wb / Lm_, i_limit_);
 
