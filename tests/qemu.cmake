@@ -65,3 +65,11 @@ add_test(NAME qemu_pil_mps2_an386
                  --work ${CMAKE_BINARY_DIR}/qemu-work-pil)
 # Alone: the figures it prints are instruction counts, but one QEMU keeps a core busy.
 set_tests_properties(qemu_pil_mps2_an386 PROPERTIES LABELS qemu RUN_SERIAL ON TIMEOUT 900)
+# The same image with the field-oriented law chosen on its command line.
+add_test(NAME qemu_pil_mps2_an386_ifoc
+         COMMAND /usr/bin/python3 ${CMAKE_CURRENT_SOURCE_DIR}/qemu/pil_test.py
+                 --elf ${CMAKE_BINARY_DIR}/qemu-cortex-m4f/bin/drive_pil_mps2_an386.elf
+                 --drive-sim $<TARGET_FILE:drive_sim>
+                 --scenario ${PROJECT_SOURCE_DIR}/hal_sim/scenarios/seed000_realistic.toml
+                 --controller ifoc --work ${CMAKE_BINARY_DIR}/qemu-work-pil-ifoc)
+set_tests_properties(qemu_pil_mps2_an386_ifoc PROPERTIES LABELS qemu RUN_SERIAL ON TIMEOUT 900)

@@ -4,13 +4,16 @@
 /// sensors, the control stage runs Drive<float>. The timer is in lock-step: after each tick
 /// time stands still while the main loop advances the plant by one period (in double, which
 /// this FPU does not have, so it is far slower than real time) and fills the references ahead.
-/// The scenario is compiled in (seed000_realistic_scenario.cpp). At the end the summary goes
-/// to the UART and the run ends through semihosting with the exit status:
-///   0 the run completed with no fault and no overrun, 1 it did not, 3 a processor fault.
+/// The scenarios are compiled in (seed000_realistic_scenario.cpp, seed001_realistic_scenario.cpp);
+/// the emulator's command line chooses one and may change its law (pil_options.hpp). At the end
+/// the summary goes to the UART and the run ends through semihosting with the exit status:
+///   0 the run completed with no fault and no overrun, 1 it did not, 2 a bad command line,
+///   3 a processor fault.
 #include <cmath>
 #include <cstdint>
 
 #include "firmware/cortex_m/pil/mps2_an386.hpp"
+#include "firmware/cortex_m/pil/pil_options.hpp"
 #include "firmware/cortex_m/pil/pil_report.hpp"
 #include "firmware/drive.hpp"
 #include "hal_sim/drive/embedded_scenario.hpp"
@@ -27,6 +30,7 @@
 namespace imd::firmware {
 
 extern const sim::EmbeddedScenario kSeed000Realistic;
+extern const sim::EmbeddedScenario kSeed001Realistic;
 
 namespace {
 
@@ -57,7 +61,7 @@ void wait_for_tick(const cm::TwoStageTick& timer) noexcept {
   cm::enable_interrupts();
 }
 
-int run(const sim::EmbeddedScenario& s, cm::CmsdkUart& console) {
+int run(const sim::EmbeddedScenario& s, const DriveConfig& drive_config, cm::CmsdkUart& console) {
   static sim::SimBoard board(s.plant, s.board);
   board.set_load_profile(s.load);
   board.plant().set_state(s.initial_state);
@@ -66,14 +70,14 @@ int run(const sim::EmbeddedScenario& s, cm::CmsdkUart& console) {
   static cm::TwoStageTick timer(
       {mps2::kCoreClock_Hz, static_cast<uint32_t>(s.board.period_s * 1e9 + 0.5), true}, sensors);
   // The realistic board: the drive's own sensing, estimation and SVPWM, no substitutes.
-  static sim::SimulatedDrive<float> simulated(board, s.motor, s.drive, {}, &references, timer,
+  static sim::SimulatedDrive<float> simulated(board, s.motor, drive_config, {}, &references, timer,
                                               &board.can());
   Drive<float>& drive = simulated.drive();
   // The same rows and metrics as drive_sim's (hal_sim/drive/tick_observer.hpp).
   static sim::TickObserver<float> observer(
-      sim::observed_run(s.references, s.settle_s, s.motor, s.drive));
+      sim::observed_run(s.references, s.settle_s, s.motor, drive_config));
   PilReport report(console);
-  report.start(s, timer.counts_per_period());  // with the stack used so far: the start-up's
+  report.start(s, drive_config, timer.counts_per_period());  // with the stack used so far: the start-up's
 
   const auto ticks = static_cast<uint64_t>(s.duration_s / s.board.period_s + 0.5);
   uint64_t frames_sent = 0;
@@ -124,5 +128,20 @@ int main() {
   static hal::cortex_m::CmsdkUart console(firmware::mps2::kUart0, firmware::mps2::kCoreClock_Hz,
                                           firmware::mps2::kUartBaud_Hz);
   firmware::g_console = &console;
-  hal::cortex_m::semihosting_exit(firmware::run(firmware::kSeed000Realistic, console));
+  static char command_line[128];
+  if (!hal::cortex_m::semihosting_command_line(command_line, sizeof command_line)) {
+    command_line[0] = '\0';
+  }
+  static const sim::EmbeddedScenario* const scenarios[] = {&firmware::kSeed000Realistic,
+                                                           &firmware::kSeed001Realistic};
+  static firmware::PilOptions options = firmware::parse_pil_options(command_line, scenarios);
+  if (options.error != nullptr) {
+    console.write("pil error ");
+    console.write(options.error);
+    console.write(" in the command line: ");
+    console.write(command_line);
+    console.write("\n");
+    hal::cortex_m::semihosting_exit(2);
+  }
+  hal::cortex_m::semihosting_exit(firmware::run(*options.scenario, options.drive, console));
 }

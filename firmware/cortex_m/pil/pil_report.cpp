@@ -1,5 +1,6 @@
 #include "firmware/cortex_m/pil/pil_report.hpp"
 
+#include "firmware/protocol/messages.hpp"
 #include "hal/cortex_m/stack_usage.hpp"
 #include "hal/cortex_m/text_line.hpp"
 
@@ -7,9 +8,11 @@ namespace imd::firmware {
 
 using hal::cortex_m::TextLine;
 
-void PilReport::start(const sim::EmbeddedScenario& s, uint32_t counts_per_period) noexcept {
+void PilReport::start(const sim::EmbeddedScenario& s, const DriveConfig& drive,
+                      uint32_t counts_per_period) noexcept {
   TextLine line;
-  line << "pil start scenario " << s.name << " duration_s ";
+  line << "pil start scenario " << s.name << " controller "
+       << protocol::kControllerValues[static_cast<int>(drive.controller)].name << " duration_s ";
   line.scientific(s.duration_s, 4) << " counts_per_period " << uint64_t(counts_per_period)
                                    << " startup_stack_bytes "
                                    << uint64_t(hal::cortex_m::stack_used_bytes()) << "\n";

@@ -19,7 +19,9 @@ class PilReport {
  public:
   explicit PilReport(hal::cortex_m::CmsdkUart& console) noexcept : console_(console) {}
 
-  void start(const sim::EmbeddedScenario& s, uint32_t counts_per_period) noexcept;
+  /// The scenario, the law that runs it and the stack used so far.
+  void start(const sim::EmbeddedScenario& s, const DriveConfig& drive,
+             uint32_t counts_per_period) noexcept;
   /// Prints each stage's mean counts per tick.
   void stages(const sim::StageTotals& totals, uint32_t clock_Hz) noexcept;
   /// Prints the summary; returns the exit status (0: no fault, no overrun, metrics measured).

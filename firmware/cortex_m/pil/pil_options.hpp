@@ -1,0 +1,24 @@
+#pragma once
+/// The processor-in-the-loop run's options, from the emulator's command line (semihosting):
+/// words "scenario=NAME" (one of the compiled-in scenarios) and "controller=NAME" (a law of
+/// firmware/laws/law_registry.hpp, instead of the scenario's); other words are ignored (the
+/// first is the program's name). tests/qemu/pil_test.py and tools/compare_controllers.py pass
+/// them as QEMU's -semihosting-config arg=... .
+#include <span>
+#include <string_view>
+
+#include "firmware/drive_config.hpp"
+#include "hal_sim/drive/embedded_scenario.hpp"
+
+namespace imd::firmware {
+
+struct PilOptions {
+  const sim::EmbeddedScenario* scenario = nullptr;  ///< the first compiled in, by default
+  DriveConfig drive;                                ///< the scenario's, the law replaced
+  const char* error = nullptr;  ///< a word that names nothing known: the run does not start
+};
+
+PilOptions parse_pil_options(std::string_view command_line,
+                             std::span<const sim::EmbeddedScenario* const> scenarios) noexcept;
+
+}  // namespace imd::firmware
