@@ -176,7 +176,7 @@ Scenario load_scenario(const std::filesystem::path& path,
     r.fail("drive.sample_period_s",
            fmt::format("= {}: must be in [1e-6, 1e-2] s", s.sample_period_s));
   }
-  s.controller = r.choice("drive.controller", "dsmc", {"dsmc", "iol", "ifoc"});
+  s.controller = r.choice("drive.controller", "dsmc", kScenarioControllers);
   const bool iol = s.controller == "iol";
   s.iol_period_s = r.positive("drive.iol_period_s", 1e-3);
   const double ratio = s.iol_period_s / s.sample_period_s;

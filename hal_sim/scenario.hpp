@@ -6,6 +6,7 @@
 #include <limits>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <utility>
 #include <vector>
 
@@ -51,6 +52,11 @@ struct ProtectionSettings {
   std::optional<double> stop_decel_rad_s2;  ///< deceleration of the stop on a disable command
 };
 
+/// The laws a scenario may name in drive.controller: the drive's laws by the CAN protocol's
+/// names (firmware/protocol/messages.hpp; the simulator's core does not depend on the firmware,
+/// so a test checks that the two lists agree).
+inline constexpr std::string_view kScenarioControllers[] = {"dsmc", "iol", "ifoc"};
+
 struct Scenario {
   std::string source;  ///< file name, for messages and the summary
   control::MotorParameters motor;  ///< what the controller knows: [motor] or motor_file
@@ -59,7 +65,7 @@ struct Scenario {
 
   // [drive]
   double sample_period_s = 1e-4;
-  std::string controller = "dsmc";  ///< "dsmc" (paper 000), "iol" (paper 001) or "ifoc"
+  std::string controller = "dsmc";  ///< one of kScenarioControllers
   std::string precision = "double";  ///< control arithmetic: "double" or "float"
   double max_accel_rad_s2 = 0.0;     ///< speed reference ramp; inf: none
   /// Where the speed reference comes from: "profile" ([reference.speed]) or "can" (only from

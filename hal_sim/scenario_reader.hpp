@@ -14,6 +14,7 @@
 #include <set>
 #include <sstream>
 #include <string>
+#include <span>
 #include <string_view>
 #include <vector>
 
@@ -99,6 +100,10 @@ class Reader {
   }
   std::string choice(std::string_view path, std::string fallback,
                      std::initializer_list<std::string_view> allowed) {
+    return choice(path, std::move(fallback), std::span<const std::string_view>(allowed));
+  }
+  std::string choice(std::string_view path, std::string fallback,
+                     std::span<const std::string_view> allowed) {
     const toml::node* node = find(path);
     if (node == nullptr) return fallback;
     const auto* value = node->as_string();

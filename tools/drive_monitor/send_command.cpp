@@ -24,7 +24,7 @@ constexpr CommandWord kWords[] = {
     {"clear-faults", CommandKind::clear_faults, nullptr},
     {"set-speed", CommandKind::set_speed, "RAD_S"},
     {"set-flux", CommandKind::set_flux, "WB2"},
-    {"select-controller", CommandKind::select_controller, "dsmc|iol|ifoc"},
+    {"select-controller", CommandKind::select_controller, "LAW"},  // a name of kControllerValues
     {"set-telemetry-rate", CommandKind::set_telemetry_rate, "HZ"},
 };
 
@@ -98,7 +98,15 @@ std::string command_usage() {
   for (const CommandWord& w : kWords) {
     if (!usage.empty()) usage += ", ";
     usage += w.word;
-    if (w.value_name != nullptr) usage += std::string(" ") + w.value_name;
+    if (w.kind == CommandKind::select_controller) {
+      std::string laws;  // the protocol's names, as the DBC has them
+      for (const protocol::ValueName& v : protocol::kControllerValues) {
+        laws += (laws.empty() ? "" : "|") + std::string(v.name);
+      }
+      usage += " " + laws;
+    } else if (w.value_name != nullptr) {
+      usage += std::string(" ") + w.value_name;
+    }
   }
   return usage;
 }

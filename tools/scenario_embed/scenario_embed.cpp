@@ -13,6 +13,7 @@
 #include <iostream>
 #include <string>
 
+#include "firmware/protocol/messages.hpp"
 #include "hal_sim/drive/scenario_config.hpp"
 #include "hal_sim/config_error.hpp"
 #include "hal_sim/scenario.hpp"
@@ -115,10 +116,10 @@ void write_board(Writer& w, const imd::sim::SimBoardConfig& b) {
 
 void write_drive(Writer& w, const DriveConfig& c) {
   w.number("drive.sample_period_s", c.sample_period_s);
-  const char* controller = c.controller == ControllerKind::iol    ? "ControllerKind::iol"
-                           : c.controller == ControllerKind::ifoc ? "ControllerKind::ifoc"
-                                                                  : "ControllerKind::dsmc";
-  w.line("drive.controller", controller);
+  // The enumerators are named as the CAN protocol names the laws.
+  w.line("drive.controller",
+         fmt::format("ControllerKind::{}",
+                     imd::firmware::protocol::kControllerValues[static_cast<int>(c.controller)].name));
   w.integer("drive.pwm_latency_ticks", c.pwm_latency_ticks);
   w.boolean("drive.compensate_latency", c.compensate_latency);
   w.number("drive.iol_period_s", c.iol_period_s);
