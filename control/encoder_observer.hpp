@@ -64,6 +64,30 @@ T wrap_pi(T angle_rad) noexcept {
   return (shifted < T(0) ? shifted + two_pi : shifted) - T(std::numbers::pi);
 }
 
+/// The largest speed and load-estimate errors that the angle's quantization can cause: the
+/// measured angle is off by at most one step q, and the errors answer it through the impulse
+/// response (A - L C A)^j L, so they are bounded by q times its l1 norm. Construction only.
+struct QuantizationErrorBounds {
+  double omega_rad_s = 0.0;
+  double load_Nm = 0.0;
+};
+inline QuantizationErrorBounds encoder_quantization_bounds(const VoltageFedCoefficients& c,
+                                                           double bandwidth_rad_s, double q_rad) {
+  Eigen::Vector3d response = place_encoder_observer(c, bandwidth_rad_s);
+  const Eigen::Matrix3d error = encoder_observer_error_matrix(c, response);
+  QuantizationErrorBounds b;
+  // The triple pole z = e^{-bandwidth delta} decays as k^2 z^k: 60 time constants leave 1e-20.
+  const int terms = static_cast<int>(60.0 / (bandwidth_rad_s * c.delta_s)) + 100;
+  for (int j = 0; j < terms; ++j) {
+    b.omega_rad_s += std::abs(response(1));
+    b.load_Nm += std::abs(response(2));
+    response = error * response;
+  }
+  b.omega_rad_s *= q_rad;
+  b.load_Nm *= q_rad;
+  return b;
+}
+
 template <typename T>
 class EncoderObserver {
  public:

@@ -1,11 +1,14 @@
 #pragma once
 /// Encoder plausibility. Two failures are caught:
 ///  - a jump: more counts in one tick than 1.5 x the overspeed limit could produce;
-///  - silence: no count while the motion model says the rotor has turned by more than
-///    `missing_counts`. The model starts from the estimated speed and load at the last count
+///  - silence: no count while the motion model says the rotor has turned by more than it can
+///    have turned unseen. The model starts from the estimated speed and load at the last count
 ///    and integrates the electromagnetic torque the drive applies, so a rotor that is braked to
-///    a stop, or held at standstill, predicts no motion. It is re-anchored every `window_s`:
-///    an estimation bias b then shifts the prediction by at most b window^2 / (2 J).
+///    a stop, or held at standstill, predicts no motion. Its start is only as good as those
+///    estimates: the encoder's quantization alone leaves them off by up to dw and dL (the
+///    observer's bounds, control/encoder_observer.hpp), which move the model by dw t +
+///    dL t^2 / (2 J) after t of silence. The allowance is that plus `missing_counts`. It is
+///    re-anchored every `window_s`: a drift of the held torque then counts for one window only.
 /// Tick context, no heap.
 #include <cmath>
 #include <cstdint>
@@ -29,9 +32,12 @@ class EncoderCheck {
     double period_s = 1e-4;
     double J_kgm2 = 0.01;
     double friction_Nms = 0.0;
-    double missing_counts = 6.0;
-    double window_s = 0.01;
+    double missing_counts = 2.0;
+    double window_s = 0.02;
     double overspeed_rad_s = 400.0;
+    /// The estimates' errors from quantization (control/encoder_quantization_bounds).
+    double speed_error_rad_s = 0.0;
+    double load_error_Nm = 0.0;
   };
 
   explicit EncoderCheck(const Config& c) noexcept
@@ -39,6 +45,8 @@ class EncoderCheck {
         per_J_(T(1.0 / c.J_kgm2)),
         friction_(T(c.friction_Nms)),
         missing_rad_(T(c.missing_counts * 2.0 * std::numbers::pi / c.counts_per_rev)),
+        speed_error_T_(T(c.speed_error_rad_s * c.period_s)),
+        load_error_T2_per_2J_(T(c.load_error_Nm * c.period_s * c.period_s / (2.0 * c.J_kgm2))),
         window_ticks_(static_cast<uint32_t>(std::ceil(c.window_s / c.period_s))),
         max_jump_counts_(
             static_cast<int32_t>(std::ceil(1.5 * c.overspeed_rad_s * c.period_s * c.counts_per_rev /
@@ -64,8 +72,8 @@ class EncoderCheck {
       reset();
       return false;
     }
-    // The model predicted `travel_rad_` over the silence so far.
-    if (delta_counts == 0 && std::abs(travel_rad_) > missing_rad_) return true;
+    // The model predicted `travel_rad_` over the silence so far (silent_ticks_ periods).
+    if (delta_counts == 0 && std::abs(travel_rad_) > allowance_rad(silent_ticks_)) return true;
     if (delta_counts != 0 || silent_ticks_ >= window_ticks_) {  // anchor to the estimate
       omega_rad_s_ = omega_est_rad_s;
       load_Nm_ = load_est_Nm;
@@ -79,9 +87,14 @@ class EncoderCheck {
   }
 
   int32_t max_jump_counts() const noexcept { return max_jump_counts_; }
+  /// The travel the model may show after this many periods of silence without a trip.
+  T allowance_rad(uint32_t ticks) const noexcept {
+    const T n = T(ticks);
+    return missing_rad_ + speed_error_T_ * n + load_error_T2_per_2J_ * n * n;
+  }
 
  private:
-  T period_s_, per_J_, friction_, missing_rad_;
+  T period_s_, per_J_, friction_, missing_rad_, speed_error_T_, load_error_T2_per_2J_;
   uint32_t window_ticks_;
   int32_t max_jump_counts_;
   uint32_t silent_ticks_ = 0;

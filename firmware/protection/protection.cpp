@@ -1,6 +1,10 @@
 #include "firmware/protection/protection.hpp"
 
 #include <cmath>
+#include <numbers>
+
+#include "control/encoder_observer.hpp"
+#include "control/voltage_fed_model.hpp"
 
 #include "firmware/duration_ticks.hpp"
 
@@ -15,6 +19,25 @@ uint32_t saturated(uint64_t ticks) noexcept {
 template <typename T>
 bool finite(const control::Vec2<T>& v) noexcept {
   return std::isfinite(v.x()) && std::isfinite(v.y());
+}
+
+/// The encoder check's configuration, with the estimates' quantization errors of the encoder
+/// observer the drive runs (construction only).
+template <typename T>
+typename EncoderCheck<T>::Config encoder_config(const control::MotorParameters& motor,
+                                                const DriveConfig& config, double counts_per_rev) {
+  const control::QuantizationErrorBounds q = control::encoder_quantization_bounds(
+      control::discretize_voltage_fed(motor, config.sample_period_s),
+      config.encoder_observer_bandwidth_rad_s, 2.0 * std::numbers::pi / counts_per_rev);
+  return {counts_per_rev,
+          config.sample_period_s,
+          motor.J_kgm2,
+          motor.friction_Nms,
+          config.protection.encoder_missing_counts,
+          config.protection.encoder_window_s,
+          config.protection.overspeed_rad_s,
+          q.omega_rad_s,
+          q.load_Nm};
 }
 
 }  // namespace
@@ -34,9 +57,7 @@ Protection<T>::Protection(const control::MotorParameters& motor, const DriveConf
           saturated(duration_ticks(config.magnetizing_timeout_s, config.sample_period_s))),
       command_timeout_ticks_(
           saturated(duration_ticks(config.protection.command_timeout_s, config.sample_period_s))),
-      encoder_check_({counts_per_rev, config.sample_period_s, motor.J_kgm2, motor.friction_Nms,
-                      config.protection.encoder_missing_counts, config.protection.encoder_window_s,
-                      config.protection.overspeed_rad_s}),
+      encoder_check_(encoder_config<T>(motor, config, counts_per_rev)),
       adc_stuck_check_(config.protection.adc_stuck_ticks, config.sample_period_s,
                        control::derive_voltage_fed(motor).sigma_H, adc_A_per_code),
       phase_loss_check_(config.protection.phase_loss_ratio,

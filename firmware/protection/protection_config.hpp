@@ -16,9 +16,13 @@ struct ProtectionConfig {
   double bus_min_V = 20.0;         ///< below: undervoltage while enabled (also a NaN reading)
   double bus_max_V = 450.0;        ///< above: overvoltage, in every state
   double overspeed_rad_s = 400.0;  ///< |estimated mechanical speed| above: overspeed
-  /// Encoder: counts the motion model predicts within one window without a count being seen.
-  double encoder_missing_counts = 4.0;
-  double encoder_window_s = 0.01;  ///< the model is re-anchored to the estimate after this
+  /// Encoder: counts the motion model may predict without a count being seen, beyond what the
+  /// estimates' quantization errors allow (docs/safety.md): one for the count at the anchor,
+  /// one to spare.
+  double encoder_missing_counts = 2.0;
+  /// The model is re-anchored to the estimate after this. Longer detects a loss at a lower
+  /// acceleration from rest (docs/safety.md); 20 ms detects 157 rad/s^2 on the paper motor.
+  double encoder_window_s = 0.02;
   /// ADC stuck: ticks with identical phase codes while the applied voltage should have moved
   /// the current by several codes.
   int adc_stuck_ticks = 20;

@@ -5,6 +5,7 @@
 #include <Eigen/Eigenvalues>
 #include <cmath>
 #include <numbers>
+#include <vector>
 
 #include "control/encoder_observer.hpp"
 #include "control/voltage_fed_model.hpp"
@@ -149,6 +150,45 @@ void expect_wrap_pi_is_fmods() {
 TEST(WrapPi, EqualsTheFmodFormulaBitForBit) {
   expect_wrap_pi_is_fmods<float>();
   expect_wrap_pi_is_fmods<double>();
+}
+
+}  // namespace
+}  // namespace imd::control
+
+namespace imd::control {
+namespace {
+
+TEST(EncoderObserver, QuantizationBoundsAreReachedAndNotExceeded) {
+  constexpr double kCount = 2 * std::numbers::pi / 8192;
+  for (const test::TestMotor& motor : test::test_motors()) {
+    SCOPED_TRACE(motor.name);
+    const auto c = discretize_voltage_fed(motor.parameters, 1e-4);
+    const QuantizationErrorBounds b = encoder_quantization_bounds(c, 400.0, kCount);
+    // A rotor at rest: every error is the measurement's. The sequence that takes each step's
+    // error to the sign of the speed error's impulse response at the end reaches the bound
+    // there; a rotor dithering across a count edge, at any period, stays within it.
+    const Eigen::Vector3d gain = place_encoder_observer(c, 400.0);
+    const Eigen::Matrix3d error = encoder_observer_error_matrix(c, gain);
+    const int n = 3000;
+    std::vector<double> sign(n);
+    Eigen::Vector3d response = gain;
+    for (int j = 0; j < n; ++j, response = error * response) sign[j] = response(1) >= 0 ? 1 : -1;
+    EncoderObserver<double> worst(c, {400.0});
+    for (int k = 0; k < n; ++k) {
+      worst.predict(Vec2<double>::Zero(), Vec2<double>::Zero(), Vec2<double>::Zero());
+      worst.correct(kCount * sign[n - 1 - k]);
+    }
+    EXPECT_NEAR(worst.omega_mech_rad_s(), b.omega_rad_s, 1e-6 * b.omega_rad_s);
+    for (int period : {1, 2, 3, 7, 20, 63, 200}) {
+      EncoderObserver<double> dither(c, {400.0});
+      for (int k = 0; k < 20000; ++k) {
+        dither.predict(Vec2<double>::Zero(), Vec2<double>::Zero(), Vec2<double>::Zero());
+        dither.correct((k / period) % 2 == 0 ? 0.0 : kCount);
+        ASSERT_LE(std::abs(dither.omega_mech_rad_s()), b.omega_rad_s);
+        ASSERT_LE(std::abs(dither.load_Nm()), b.load_Nm);
+      }
+    }
+  }
 }
 
 }  // namespace

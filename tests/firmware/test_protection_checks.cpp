@@ -109,6 +109,31 @@ TEST(EncoderCheck, AHeldRotorWithAnEstimationBiasPasses) {
   for (int k = 0; k < 100000; ++k) ASSERT_FALSE(check.failed(0, 0.0, 1.0, 1.5)) << k;
 }
 
+TEST(EncoderCheck, AStartOffByTheQuantizationErrorsPasses) {
+  // A rotor held at standstill dithering across a count edge: each count re-anchors the model
+  // to estimates the observer has just corrected, off by up to dw and dL (the paper motor's
+  // bounds at 400 rad/s: 0.53 rad/s and 0.76 N m). The allowance grows with them; without it the
+  // same start trips.
+  EncoderCheck<double>::Config config = encoder_config();
+  config.missing_counts = 2.0;
+  config.window_s = 0.02;
+  config.speed_error_rad_s = 0.53;
+  config.load_error_Nm = 0.76;
+  EncoderCheck<double> check(config);
+  EncoderCheck<double>::Config bare = config;
+  bare.speed_error_rad_s = bare.load_error_Nm = 0.0;
+  EncoderCheck<double> without(bare);
+  bool bare_tripped = false;
+  for (int k = 0; k < 20000; ++k) {
+    const int32_t delta = k % 400 == 0 ? (k % 800 == 0 ? 1 : -1) : 0;  // a count every 40 ms
+    ASSERT_FALSE(check.failed(delta, 0.9 * 0.53, -0.9 * 0.76, 0.0)) << k;
+    bare_tripped = bare_tripped || without.failed(delta, 0.9 * 0.53, -0.9 * 0.76, 0.0);
+  }
+  EXPECT_TRUE(bare_tripped);
+  // And the allowance is what the class says: 2 counts, then dw t + dL t^2 / (2 J).
+  EXPECT_NEAR(check.allowance_rad(100), 2 * kCountRad + 0.53 * 0.01 + 0.76 * 1e-4 / 0.02, 1e-15);
+}
+
 TEST(EncoderCheck, ABrakedStopPasses) {
   // 2 rad/s braked at 200 rad/s^2 (2 N m on J = 0.01): it stops after 1e-2 rad = 13 counts;
   // the counts stop with it, and the model's braking predicts the stop.

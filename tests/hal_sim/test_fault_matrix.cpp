@@ -4,9 +4,12 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <numbers>
 #include <cstdio>
 #include <string>
 
+#include "control/encoder_observer.hpp"
+#include "control/voltage_fed_model.hpp"
 #include "firmware/drive_state.hpp"
 #include "hal_sim/scenario.hpp"
 #include "hal_sim/drive/scenario_run.hpp"
@@ -97,11 +100,20 @@ TEST(FaultMatrix, EncoderLoss) {
 }
 
 TEST(FaultMatrix, EncoderLossAtLowSpeed) {
-  // At the sine's zero crossing (t = 2 s, 0 rad/s, accelerating at 157 rad/s^2): the model's
-  // acceleration alone predicts the six missing counts.
+  // At the sine's zero crossing (t = 2 s, 0 rad/s, accelerating at a = 157 rad/s^2). The check
+  // allows the travel its start's quantization errors dw, dL can explain, 2 q + dw t +
+  // dL t^2 / (2 J), so the model's acceleration trips it at the t where
+  // (a - dL / J) t^2 / 2 = 2 q + dw t (15.5 ms for the paper motor), within the 20 ms window.
   Scenario s = base("seed000_realistic.toml");
   s.duration_s = 2.3;
-  run_case(s, {at(2.0, FaultKind::encoder_loss), "encoder", 0.01});
+  const double q = 2 * std::numbers::pi / s.encoder_cpr;
+  const auto e = control::encoder_quantization_bounds(
+      control::discretize_voltage_fed(s.motor, s.sample_period_s), s.encoder_bandwidth_rad_s, q);
+  const double a = 2 * std::numbers::pi * 0.25 * 100.0 - e.load_Nm / s.motor.J_kgm2;
+  const double t = (e.omega_rad_s + std::sqrt(e.omega_rad_s * e.omega_rad_s + 4 * a * q)) / a;
+  EXPECT_GT(t, 0.015);
+  EXPECT_LT(t, 0.02);
+  run_case(s, {at(2.0, FaultKind::encoder_loss), "encoder", t + kTick_s});
 }
 
 TEST(FaultMatrix, AdcStuck) {
