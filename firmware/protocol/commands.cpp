@@ -5,6 +5,14 @@
 namespace imd::firmware::protocol {
 namespace {
 
+/// A raw value of the protocol's controller table (the laws the drive registers).
+bool names_a_law(float value) noexcept {
+  for (const ValueName& v : kControllerValues) {
+    if (value == static_cast<float>(v.raw)) return true;
+  }
+  return false;
+}
+
 constexpr const Signal& payload_signal(MessageId id) noexcept {
   return message(id).signals[2];
 }
@@ -99,7 +107,7 @@ Decoded CommandDecoder::decode(const hal::CanFrame& frame) noexcept {
     case MessageId::select_controller:
       c.kind = CommandKind::select_controller;
       c.value = get_physical(frame.data, payload_signal(MessageId::select_controller));
-      if (!(c.value == 0.0f || c.value == 1.0f)) return reject(d, CommandResult::out_of_range);
+      if (!names_a_law(c.value)) return reject(d, CommandResult::out_of_range);
       break;
     case MessageId::set_telemetry_rate:
       c.kind = CommandKind::set_telemetry_rate;

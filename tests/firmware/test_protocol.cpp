@@ -146,8 +146,8 @@ TEST_F(Decoder, RejectsOutOfRangeValues) {
             CommandResult::out_of_range);  // below the 0.01 Wb^2 floor
   EXPECT_EQ(decoder.decode(encoder.encode({CommandKind::set_flux, 1.5f})).result,
             CommandResult::out_of_range);
-  EXPECT_EQ(decoder.decode(encoder.encode({CommandKind::select_controller, 2.0f})).result,
-            CommandResult::out_of_range);
+  EXPECT_EQ(decoder.decode(encoder.encode({CommandKind::select_controller, 3.0f})).result,
+            CommandResult::out_of_range);  // the laws are 0 (dsmc), 1 (iol), 2 (ifoc)
   EXPECT_EQ(decoder.decode(encoder.encode({CommandKind::set_telemetry_rate, 5.0f})).result,
             CommandResult::out_of_range);
   EXPECT_EQ(decoder.decode(encoder.encode({CommandKind::set_telemetry_rate, 1001.0f})).result,
