@@ -220,7 +220,7 @@ inline constexpr Message kMessages[] = {
     {MessageId::set_flux, "set_flux", 6, Direction::host_to_drive, Timing::on_event, 0,
      "squared flux reference, (0, max]", kSetFluxSignals},
     {MessageId::select_controller, "select_controller", 3, Direction::host_to_drive,
-     Timing::on_event, 0, "dsmc or iol, only while idle", kSelectControllerSignals},
+     Timing::on_event, 0, "the control law (dsmc, iol, ifoc), only while idle", kSelectControllerSignals},
     {MessageId::set_telemetry_rate, "set_telemetry_rate", 4, Direction::host_to_drive,
      Timing::on_event, 0, "fast telemetry rate", kSetTelemetryRateSignals},
     {MessageId::command_ack, "command_ack", 4, Direction::drive_to_host, Timing::on_event, 0,
