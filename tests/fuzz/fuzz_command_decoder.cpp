@@ -7,10 +7,12 @@
 // fuzzer past the CRC: bit 0 puts the identifier on the node (keeping the message id), bit 1
 // sets the table's length for that message, bit 2 writes the correct CRC, bit 3 also reports a
 // not_allowed rejection afterwards, as the application does.
+#include <algorithm>
 #include <cstddef>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
+#include <iterator>
 
 #include "firmware/protocol/commands.hpp"
 #include "firmware/protocol/e2e.hpp"
@@ -39,8 +41,10 @@ bool value_in_range(const protocol::Command& c, const protocol::CommandLimits& l
       return c.value >= -limits.max_speed_rad_s && c.value <= limits.max_speed_rad_s;
     case CommandKind::set_flux:
       return c.value >= limits.min_flux2_Wb2 && c.value <= limits.max_flux2_Wb2;
-    case CommandKind::select_controller:
-      return c.value == 0.0f || c.value == 1.0f;
+    case CommandKind::select_controller:  // a law of the protocol's table
+      return std::any_of(std::begin(protocol::kControllerValues),
+                         std::end(protocol::kControllerValues),
+                         [&](const protocol::ValueName& v) { return c.value == float(v.raw); });
     case CommandKind::set_telemetry_rate:
       return c.value >= float(protocol::kFastTelemetryMinHz) &&
              c.value <= float(protocol::kFastTelemetryMaxHz);
