@@ -53,6 +53,10 @@ struct DriveConfig {
   double i_max_A = std::numeric_limits<double>::infinity();  ///< motor and inverter current limit
   double current_margin = 0.95;  ///< share of i_max the law may plan for
 
+  // The inverter.
+  double dead_time_s = 0.0;  ///< the PWM dead time per switching edge the board programs
+  bool compensate_dead_time = true;  ///< add the dead time's voltage loss back to the duties
+
   // Start-up.
   int adc_calibration_ticks = 256;     ///< offset measurement with the PWM off; 0 skips it
   double adc_offset_limit_A = 0.5;     ///< a larger measured offset is a fault

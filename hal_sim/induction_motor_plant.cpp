@@ -104,6 +104,16 @@ void InductionMotorPlant::step_voltage(const Vec2& u_s_alphabeta_V, double load_
   integrate_voltage_fed([&](const StateVector&) { return u_s_alphabeta_V; }, load_Nm);
 }
 
+void InductionMotorPlant::step_voltage(const Vec2& u_s_alphabeta_V,
+                                       const CurrentDependentVoltage& error,
+                                       double load_Nm) noexcept {
+  integrate_voltage_fed(
+      [&](const StateVector& x) -> Vec2 {
+        return u_s_alphabeta_V + error.error_V(constrained(x.segment<2>(2)));
+      },
+      load_Nm);
+}
+
 namespace {
 
 /// Feedback (2): u = sigma p w J (I + beta Phi) + e^{p th J} v~.

@@ -35,6 +35,16 @@ struct PlantState {
 /// current is the projection of the alpha-beta current on it.
 Vec2 phase_axis(int phase) noexcept;
 
+/// A stator-voltage error that depends on the stator current (the inverter's dead time and
+/// device drop), evaluated at every integration stage.
+class CurrentDependentVoltage {
+ public:
+  virtual Vec2 error_V(const Vec2& i_s_alphabeta_A) const noexcept = 0;
+
+ protected:
+  ~CurrentDependentVoltage() = default;
+};
+
 struct PlantConfig {
   double period_s = 1e-4;  ///< one call of a step function advances this much
   int rk4_substeps = 10;   ///< RK4 steps per period
@@ -71,6 +81,9 @@ class InductionMotorPlant {
 
   /// One period with the stator voltage u held (stationary frame).
   void step_voltage(const Vec2& u_s_alphabeta_V, double load_Nm) noexcept;
+  /// One period with u held plus `error` of the instantaneous stator current.
+  void step_voltage(const Vec2& u_s_alphabeta_V, const CurrentDependentVoltage& error,
+                    double load_Nm) noexcept;
 
   /// One period under the ideal analog inner feedback (2) of paper 000:
   /// u(t) = sigma p w J (I + beta Phi) + e^{p th(t) J} v~_k, evaluated at every RK4 stage.

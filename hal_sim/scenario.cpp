@@ -251,6 +251,17 @@ Scenario load_scenario(const std::filesystem::path& path,
   }
   s.i_max_A = r.positive_or_inf("inverter.i_max_A");
   s.limit_voltage = r.boolean("inverter.limit_voltage", true);
+  s.inverter.dead_time_s = r.non_negative("inverter.dead_time_s", 0.0);
+  if (s.inverter.dead_time_s >= 0.1 * s.sample_period_s) {  // a 10 % duty loss is no inverter
+    r.fail("inverter.dead_time_s", fmt::format("= {}: must be below 0.1 * drive.sample_period_s",
+                                               s.inverter.dead_time_s));
+  }
+  s.inverter.device_drop_V = r.non_negative("inverter.device_drop_V", 0.0);
+  if (s.inverter.device_drop_V >= 0.1 * s.v_bus_V) {
+    r.fail("inverter.device_drop_V", fmt::format("= {}: must be below 0.1 * inverter.v_bus_V",
+                                                 s.inverter.device_drop_V));
+  }
+  s.dead_time_compensation = r.boolean("drive.dead_time_compensation", true);
 
   s.section_iv = r.boolean("observers.section_iv", false);
   if (s.section_iv && !s.ideal_sensors) {

@@ -102,6 +102,8 @@ struct Scenario {
   double v_bus_V = 311.0;
   double i_max_A = 0.0;       ///< inf: no current limit
   bool limit_voltage = true;  ///< false: the law ignores the bus (the paper states no limit)
+  InverterNonideality inverter;  ///< dead_time_s, device_drop_V
+  bool dead_time_compensation = true;  ///< [drive]: the firmware adds the dead time back
 
   // [observers]
   bool section_iv = false;  ///< paper's flux observer and load estimator on the ideal speed

@@ -6,6 +6,26 @@
 
 namespace imd::sim {
 
+namespace {
+
+/// The inverter's error over one period, as the plant evaluates it.
+class InverterError final : public CurrentDependentVoltage {
+ public:
+  InverterError(const InverterNonideality& inverter, const hal::PhaseDuties& duty,
+                double v_bus_V, double period_s) noexcept
+      : inverter_(inverter), duty_(duty), v_bus_V_(v_bus_V), period_s_(period_s) {}
+  Vec2 error_V(const Vec2& i_s_alphabeta_A) const noexcept override {
+    return inverter_error_V(inverter_, duty_, v_bus_V_, period_s_, i_s_alphabeta_A);
+  }
+
+ private:
+  const InverterNonideality& inverter_;
+  const hal::PhaseDuties& duty_;
+  double v_bus_V_, period_s_;
+};
+
+}  // namespace
+
 SimBoard::SimBoard(const control::MotorParameters& motor, const SimBoardConfig& config)
     : config_(config),
       plant_(motor, {config.period_s, config.substeps}),
@@ -64,9 +84,14 @@ void SimBoard::end_period() {
   } else if (config_.inner_feedback == InnerFeedback::ideal_analog) {
     applied_voltage_V_ = plant_.analog_feedback_voltage_V(active_analog_input_V_);
     plant_.step_analog_feedback(active_analog_input_V_, load_now_Nm);
-  } else {
+  } else if (config_.inverter.ideal()) {
     applied_voltage_V_ = inverter_output_V(active_duty_, v_bus_V_);
     plant_.step_voltage(applied_voltage_V_, load_now_Nm);
+  } else {
+    const InverterError error(config_.inverter, active_duty_, v_bus_V_, config_.period_s);
+    const Vec2 ideal_V = inverter_output_V(active_duty_, v_bus_V_);
+    applied_voltage_V_ = ideal_V + error.error_V(now.i_s_alphabeta_A);  // at the period's start
+    plant_.step_voltage(ideal_V, error, load_now_Nm);
   }
   if (config_.pwm_latency_ticks != 0) {
     active_duty_ = pwm_.written();

@@ -19,6 +19,7 @@
 #include "control/motor_parameters.hpp"
 #include "hal_sim/fault_injection.hpp"
 #include "hal_sim/induction_motor_plant.hpp"
+#include "hal_sim/inverter_model.hpp"
 #include "hal_sim/load_profile.hpp"
 #include "hal_sim/sensor_models.hpp"
 #include "hal_sim/sim_peripherals.hpp"
@@ -37,6 +38,7 @@ struct SimBoardConfig {
   InnerFeedback inner_feedback = InnerFeedback::digital;
   bool current_source = false;  ///< the ideal current source drives the motor
   double v_bus_V = 311.0;       ///< nominal DC bus (a bus fault changes the board's v_bus_V())
+  InverterNonideality inverter;  ///< dead time and device drop (PWM-driven motor only)
   uint32_t encoder_cpr = 8192;
   AdcModelConfig adc;
   uint64_t seed = 1;

@@ -3,10 +3,12 @@
 /// held voltage is rotated to the middle of the period it acts on, where the analog law's
 /// rotation is on average; SVPWM turns it into duties; beyond the linear range the vector is
 /// scaled down, and the input v~ that really acts is computed back from it, so that the
-/// observers see what is applied. Tick context except construction.
+/// observers see what is applied. The duties then get the dead time's loss added back
+/// (dead_time_compensation.hpp). Tick context except construction.
 #include <cmath>
 
 #include "control/svpwm.hpp"
+#include "firmware/stages/dead_time_compensation.hpp"
 #include "firmware/stages/input_limits.hpp"
 #include "firmware/stages/power_stage.hpp"
 #include "hal/pwm.hpp"
@@ -16,8 +18,9 @@ namespace imd::firmware {
 template <typename T>
 class SvpwmStage final : public PowerStage<T> {
  public:
-  SvpwmStage(hal::Pwm& pwm, const control::MotorParameters& motor, double period_s) noexcept
-      : pwm_(pwm), feedback_(motor), half_period_s_(T(period_s / 2)) {}
+  SvpwmStage(hal::Pwm& pwm, const control::MotorParameters& motor, double period_s,
+             const DeadTimeCompensation<T>& dead_time) noexcept
+      : pwm_(pwm), feedback_(motor), dead_time_(dead_time), half_period_s_(T(period_s / 2)) {}
 
   Modulation<T> modulate(const LawOutput<T>& law, const control::RotorFrameState<T>& x,
                          T v_bus_V) noexcept override {
@@ -38,6 +41,7 @@ class SvpwmStage final : public PowerStage<T> {
     }
     m.finite = finite(m.u_alphabeta_V) && finite(m.v_acting_AB_V);
     m.duty = {float(pwm.duty[0]), float(pwm.duty[1]), float(pwm.duty[2])};
+    if (dead_time_.active()) dead_time_.apply(m.duty, rotation.apply(x.i_s_AB_A), v_bus_V);
     return m;
   }
 
@@ -53,6 +57,7 @@ class SvpwmStage final : public PowerStage<T> {
 
   hal::Pwm& pwm_;
   InnerFeedback<T> feedback_;
+  DeadTimeCompensation<T> dead_time_;
   T half_period_s_;
 };
 

@@ -16,6 +16,7 @@ SimBoardConfig board_config(const Scenario& s) {
   c.inner_feedback = s.inner_feedback;
   c.current_source = s.current_fed;
   c.v_bus_V = s.v_bus_V;
+  c.inverter = s.inverter;
   c.encoder_cpr = s.encoder_cpr;
   c.adc = s.adc;
   c.seed = s.seed;
@@ -44,6 +45,8 @@ firmware::DriveConfig drive_config(const Scenario& s) {
   c.compensate_latency = s.compensate_latency;
   c.i_max_A = s.i_max_A;
   c.voltage_limited = s.limit_voltage;
+  c.dead_time_s = s.inverter.dead_time_s;  // the board programs it: the firmware knows it
+  c.compensate_dead_time = s.dead_time_compensation;
   c.max_accel_rad_s2 = s.max_accel_rad_s2;
   c.speed_reaching_pole = s.speed_reaching_pole;
   c.flux_reaching_pole = s.flux_reaching_pole;

@@ -25,8 +25,8 @@ using imd::firmware::ControllerKind;
 using imd::firmware::DriveConfig;
 
 // A new field must be written here too: these sizes fail the build until it is.
-static_assert(sizeof(DriveConfig) == 400, "DriveConfig changed: write its new fields below");
-static_assert(sizeof(imd::sim::SimBoardConfig) == 112, "SimBoardConfig changed: write it below");
+static_assert(sizeof(DriveConfig) == 408, "DriveConfig changed: write its new fields below");
+static_assert(sizeof(imd::sim::SimBoardConfig) == 128, "SimBoardConfig changed: write it below");
 static_assert(sizeof(imd::control::MotorParameters) == 64, "MotorParameters changed");
 
 class Writer {
@@ -104,6 +104,8 @@ void write_board(Writer& w, const imd::sim::SimBoardConfig& b) {
                                      : "sim::InnerFeedback::ideal_analog");
   w.boolean("board.current_source", b.current_source);
   w.number("board.v_bus_V", b.v_bus_V);
+  w.number("board.inverter.dead_time_s", b.inverter.dead_time_s);
+  w.number("board.inverter.device_drop_V", b.inverter.device_drop_V);
   w.integer("board.encoder_cpr", b.encoder_cpr);
   w.integer("board.adc.bits", b.adc.bits);
   w.number("board.adc.full_scale_A", b.adc.full_scale_A);
@@ -138,6 +140,8 @@ void write_drive(Writer& w, const DriveConfig& c) {
   w.number("drive.modulation_margin", c.modulation_margin);
   w.number("drive.i_max_A", c.i_max_A);
   w.number("drive.current_margin", c.current_margin);
+  w.number("drive.dead_time_s", c.dead_time_s);
+  w.boolean("drive.compensate_dead_time", c.compensate_dead_time);
   w.integer("drive.adc_calibration_ticks", c.adc_calibration_ticks);
   w.number("drive.adc_offset_limit_A", c.adc_offset_limit_A);
   w.number("drive.magnetizing_current_A", c.magnetizing_current_A);

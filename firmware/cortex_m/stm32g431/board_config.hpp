@@ -110,6 +110,7 @@ constexpr DriveConfig drive_config() {
   c.speed_reaching_pole = 0.98;
   c.flux_reaching_pole = 0.98;
   c.i_max_A = kCurrentLimit_A;
+  c.dead_time_s = kDeadTime_ns * 1e-9;  // what TIM1's BDTR programs, compensated in the duties
   c.max_accel_rad_s2 = 200.0;  // set_speed steps from CAN are ramped
   c.encoder_observer_bandwidth_rad_s = 400.0;
   c.adc_offset_limit_A = 0.02 * kCurrentRange_A;
