@@ -1,0 +1,94 @@
+#include "firmware/parameters/motor_record.hpp"
+
+#include <cmath>
+#include <cstring>
+
+namespace imd::firmware {
+
+double field_value(const control::MotorParameters& m, MotorField field) noexcept {
+  switch (field) {
+    case MotorField::Rs_Ohm: return m.Rs_Ohm;
+    case MotorField::Ls_H: return m.Ls_H;
+    case MotorField::Lm_H: return m.Lm_H;
+    case MotorField::Rr_Ohm: return m.Rr_Ohm;
+    case MotorField::Lr_H: return m.Lr_H;
+    case MotorField::J_kgm2: return m.J_kgm2;
+    case MotorField::pole_pairs: return double(m.pole_pairs);
+    case MotorField::friction_Nms: return m.friction_Nms;
+  }
+  return 0.0;
+}
+
+void set_field(control::MotorParameters& m, MotorField field, double value) noexcept {
+  switch (field) {
+    case MotorField::Rs_Ohm: m.Rs_Ohm = value; break;
+    case MotorField::Ls_H: m.Ls_H = value; break;
+    case MotorField::Lm_H: m.Lm_H = value; break;
+    case MotorField::Rr_Ohm: m.Rr_Ohm = value; break;
+    case MotorField::Lr_H: m.Lr_H = value; break;
+    case MotorField::J_kgm2: m.J_kgm2 = value; break;
+    case MotorField::pole_pairs: m.pole_pairs = static_cast<int>(std::lround(value)); break;
+    case MotorField::friction_Nms: m.friction_Nms = value; break;
+  }
+}
+
+ParameterStatus check_field(MotorField field, double value) noexcept {
+  if (!std::isfinite(value)) return ParameterStatus::not_finite;
+  if (field == MotorField::friction_Nms) {
+    return value < 0.0 ? ParameterStatus::negative : ParameterStatus::ok;
+  }
+  if (field == MotorField::pole_pairs) {
+    return value == std::round(value) && value >= 1.0 && value <= kMaxPolePairs
+               ? ParameterStatus::ok
+               : ParameterStatus::not_whole;
+  }
+  return value > 0.0 ? ParameterStatus::ok : ParameterStatus::not_positive;
+}
+
+ParameterStatus check_record(const control::MotorParameters& motor) noexcept {
+  for (int i = 0; i < kMotorFieldCount; ++i) {
+    const auto field = static_cast<MotorField>(i);
+    const ParameterStatus s = check_field(field, field_value(motor, field));
+    if (s != ParameterStatus::ok) return s;
+  }
+  // The coupling rule is the last of find_invalid_parameter's, after those checked above.
+  return control::find_invalid_parameter(motor) ? ParameterStatus::no_leakage
+                                                : ParameterStatus::ok;
+}
+
+std::array<uint8_t, kMotorRecordBytes> encode_motor_record(
+    const control::MotorParameters& motor) noexcept {
+  std::array<uint8_t, kMotorRecordBytes> out{};
+  out[0] = static_cast<uint8_t>(kMotorRecordVersion);
+  out[1] = static_cast<uint8_t>(kMotorRecordVersion >> 8);
+  out[2] = kMotorFieldCount;
+  out[3] = 0;
+  for (int i = 0; i < kMotorFieldCount; ++i) {
+    const double v = field_value(motor, static_cast<MotorField>(i));
+    uint64_t bits = 0;
+    std::memcpy(&bits, &v, sizeof bits);
+    for (int b = 0; b < 8; ++b) out[4 + 8 * i + b] = static_cast<uint8_t>(bits >> (8 * b));
+  }
+  return out;
+}
+
+std::optional<control::MotorParameters> decode_motor_record(
+    std::span<const uint8_t> bytes) noexcept {
+  if (bytes.size() != kMotorRecordBytes) return std::nullopt;
+  const uint16_t version = static_cast<uint16_t>(bytes[0] | bytes[1] << 8);
+  if (version != kMotorRecordVersion || bytes[2] != kMotorFieldCount) return std::nullopt;
+  control::MotorParameters motor;
+  for (int i = 0; i < kMotorFieldCount; ++i) {
+    uint64_t bits = 0;
+    for (int b = 0; b < 8; ++b) bits |= uint64_t(bytes[4 + 8 * i + b]) << (8 * b);
+    double v = 0.0;
+    std::memcpy(&v, &bits, sizeof v);
+    const auto field = static_cast<MotorField>(i);
+    if (check_field(field, v) != ParameterStatus::ok) return std::nullopt;
+    set_field(motor, field, v);
+  }
+  if (check_record(motor) != ParameterStatus::ok) return std::nullopt;
+  return motor;
+}
+
+}  // namespace imd::firmware
