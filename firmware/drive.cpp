@@ -6,32 +6,35 @@
 namespace imd::firmware {
 
 template <typename T>
-Drive<T>::Drive(const control::MotorParameters& motor, const DriveConfig& config,
+std::optional<MotorModel<T>> Drive<T>::build(const std::optional<control::MotorParameters>& motor,
+                                             const DriveConfig& config, const BoardScales& board) {
+  if (!motor) return std::nullopt;
+  return std::optional<MotorModel<T>>(std::in_place, *motor, config, board);
+}
+
+template <typename T>
+Drive<T>::Drive(const std::optional<control::MotorParameters>& motor, const DriveConfig& config,
                 const DrivePeripherals& peripherals, const DriveSubstitutes<T>& substitutes)
     : config_(config),
       hw_(peripherals),
-      coefficients_(control::discretize_voltage_fed(motor, config.sample_period_s)),
+      substitutes_(substitutes),
+      board_{peripherals.pwm, double(peripherals.encoder.counts_per_rev()),
+             double(peripherals.adc.scale().phase_A_per_code)},
       board_sensing_(peripherals.adc, peripherals.encoder,
                      {config.adc_calibration_ticks, config.adc_offset_limit_A}),
       sensing_(substitutes.sensing != nullptr ? *substitutes.sensing : board_sensing_),
-      observers_(coefficients_, motor.pole_pairs, config.encoder_observer_bandwidth_rad_s),
-      estimator_(substitutes.estimator != nullptr ? *substitutes.estimator : observers_),
-      predictor_(coefficients_, config.pwm_latency_ticks, config.compensate_latency),
-      laws_(LawContext{motor, config, coefficients_}),
-      magnetizer_(motor, coefficients_, config),
-      limits_(motor, coefficients_,
-              {config.voltage_limited, config.modulation_margin, config.i_max_A,
-               config.current_margin}),
-      svpwm_(peripherals.pwm, motor, config.sample_period_s,
-             {config.compensate_dead_time, config.dead_time_s, config.sample_period_s,
-              control::derive_voltage_fed(motor).sigma_H}),
-      power_stage_(substitutes.power_stage != nullptr ? *substitutes.power_stage : svpwm_),
-      protection_(motor, config, double(peripherals.encoder.counts_per_rev()),
-                  double(peripherals.adc.scale().phase_A_per_code)),
+      bank_(motor),
+      model_(build(motor, config, board_)),
+      model_ready_(model_.has_value()),
+      attached_(model_ ? &*model_ : nullptr),
+      protection_(config),
       telemetry_(config.node_id, peripherals.timer.period_ns(), config.telemetry_rate_Hz,
                  static_cast<float>(1e9 / double(peripherals.timer.execution_clock_Hz()))),
-      supervisor_(config, {peripherals.can, peripherals.gpio, telemetry_}, substitutes.references,
-                  laws_, magnetizer_, predictor_.predicts(), config.adc_calibration_ticks <= 0),
+      supervisor_(config, {peripherals.can, peripherals.gpio, telemetry_, &bank_},
+                  substitutes.references, model_ ? &model_->laws : nullptr,
+                  model_ ? &model_->magnetizer : nullptr,
+                  config.compensate_latency && config.pwm_latency_ticks > 0,
+                  config.adc_calibration_ticks <= 0),
       clock_Hz_(peripherals.timer.execution_clock_Hz()),
       ns_per_count_(static_cast<float>(1e9 / double(clock_Hz_))) {
   protection_.set_clock(clock_Hz_);
@@ -47,57 +50,116 @@ void Drive<T>::on_tick() noexcept {
   const uint64_t k = hw_.timer.tick_count();
   const Measurement<T> m = sensing_.measure(supervisor_.state() == DriveState::calibrating);
   clock.lap(Stage::sense);
-  const Estimate<T> e = estimate(m);
+  MotorModel<T>* const model = this->model(k);
+  const Estimate<T> e = estimate(m, model);
   clock.lap(Stage::estimate);
   const TickPlan<T> plan = supervisor_.plan(k, m, e);
   clock.lap(Stage::supervise);
-  const LawOutput<T> u = law(plan, e, m.v_bus_V);
+  const LawOutput<T> u = law(plan, e, m.v_bus_V, model);
   clock.lap(Stage::law);
-  const Modulation<T> out =
-      plan.mode == Mode::off ? Modulation<T>{} : power_stage_.modulate(u, e.x_input, m.v_bus_V);
+  const Modulation<T> out = modulate(plan, u, e, m.v_bus_V, model);
   clock.lap(Stage::modulate);
-  const Trip trip = protection_.check(m, e, plan.supervised, u, out, u_written_V_);
+  const Trip trip = protection_.check(m, e, plan.supervised, u, out, u_written_V_,
+                                      model != nullptr ? &model->checks : nullptr);
   clock.lap(Stage::protect);
-  actuate(k, e, out, trip);
-  check_budget(k, clock.lap_total(Stage::actuate));
-  publish(k, m, e, plan, u, out);
+  actuate(k, e, out, trip, model);
+  check_budget(k, clock.lap_total(Stage::actuate), model);
+  publish(k, m, e, plan, u, out, model);
+  if (bank_.apply_wanted()) release_model();
   clock.lap(Stage::publish);
   write_line(config_.timing_output_line, false);
 }
 
 template <typename T>
-inline Estimate<T> Drive<T>::estimate(const Measurement<T>& m) noexcept {
-  if (!m.valid) return {};
-  Estimate<T> e = estimator_.estimate(m);
-  predictor_.set_input_state(e);
+inline MotorModel<T>* Drive<T>::model(uint64_t k) noexcept {
+  if (attached_ == nullptr && model_ready_.load(std::memory_order_acquire)) {
+    attached_ = &*model_;
+    supervisor_.attach(&attached_->laws, &attached_->magnetizer, k);
+  }
+  return attached_;
+}
+
+template <typename T>
+void Drive<T>::release_model() noexcept {
+  attached_ = nullptr;
+  supervisor_.attach(nullptr, nullptr, 0);
+  model_ready_.store(false, std::memory_order_relaxed);
+  bank_.request_apply();  // release: from here the service loop owns model_
+}
+
+template <typename T>
+void Drive<T>::service() noexcept {
+  switch (bank_.pending()) {
+    case ParameterBank::Request::none:
+      return;
+    case ParameterBank::Request::apply:
+      model_.reset();
+      model_.emplace(bank_.staged(), config_, board_);
+      model_ready_.store(true, std::memory_order_release);
+      bank_.complete_request(ParameterStatus::ok);
+      return;
+    case ParameterBank::Request::save: {
+      const auto record = encode_motor_record(bank_.staged());
+      const bool saved = hw_.store != nullptr && hw_.store->save(record);
+      bank_.complete_request(saved ? ParameterStatus::ok : ParameterStatus::store_failed);
+      return;
+    }
+  }
+}
+
+template <typename T>
+std::optional<control::MotorParameters> Drive<T>::motor() const noexcept {
+  if (!bank_.complete()) return std::nullopt;
+  return bank_.staged();
+}
+
+template <typename T>
+inline Estimate<T> Drive<T>::estimate(const Measurement<T>& m, MotorModel<T>* model) noexcept {
+  if (!m.valid || model == nullptr) return {};
+  StateEstimator<T>& estimator =
+      substitutes_.estimator != nullptr ? *substitutes_.estimator : model->observers;
+  Estimate<T> e = estimator.estimate(m);
+  model->predictor.set_input_state(e);
   return e;
 }
 
 template <typename T>
-inline LawOutput<T> Drive<T>::law(const TickPlan<T>& plan, const Estimate<T>& e,
-                                  T v_bus_V) noexcept {
+inline LawOutput<T> Drive<T>::law(const TickPlan<T>& plan, const Estimate<T>& e, T v_bus_V,
+                                  MotorModel<T>* model) noexcept {
   record_.law.speed_saturated = record_.law.flux_saturated = record_.law.iol_boundary = false;
   record_.law.voltage_limited = false;
-  if (plan.mode == Mode::off) return {};
-  const control::InputDisk<T> feasible = limits_.feasible(e.x_input, v_bus_V);
+  if (plan.mode == Mode::off || model == nullptr) return {};
+  const control::InputDisk<T> feasible = model->limits.feasible(e.x_input, v_bus_V);
   if (plan.mode == Mode::magnetizing) {
-    return magnetizer_.step(e.x_input, plan.next, supervisor_.controlled_flux(), feasible);
+    return model->magnetizer.step(e.x_input, plan.next, supervisor_.controlled_flux(), feasible);
   }
-  return supervisor_.law().step(
-      {e, plan.now, plan.next, plan.ahead, plan.stopping, feasible, limits_.v_max_V(v_bus_V)},
-      record_.law);
+  return supervisor_.law().step({e, plan.now, plan.next, plan.ahead, plan.stopping, feasible,
+                                 model->limits.v_max_V(v_bus_V)},
+                                record_.law);
+}
+
+template <typename T>
+inline Modulation<T> Drive<T>::modulate(const TickPlan<T>& plan, const LawOutput<T>& u,
+                                        const Estimate<T>& e, T v_bus_V,
+                                        MotorModel<T>* model) noexcept {
+  if (plan.mode == Mode::off || model == nullptr) return {};
+  PowerStage<T>& stage =
+      substitutes_.power_stage != nullptr ? *substitutes_.power_stage : model->svpwm;
+  return stage.modulate(u, e.x_input, v_bus_V);
 }
 
 template <typename T>
 inline void Drive<T>::actuate(uint64_t k, const Estimate<T>& e, const Modulation<T>& out,
-                              const Trip& trip) noexcept {
+                              const Trip& trip, MotorModel<T>* model) noexcept {
   v_applied_V_ = Vec2::Zero();
   if (trip.any()) {
     supervisor_.latch(trip, k);
     pwm_off();
     u_written_V_ = Vec2::Zero();
-  } else if (supervisor_.modulating()) {
-    power_stage_.write(out);
+  } else if (supervisor_.modulating() && model != nullptr) {
+    PowerStage<T>& stage =
+        substitutes_.power_stage != nullptr ? *substitutes_.power_stage : model->svpwm;
+    stage.write(out);
     u_written_V_ = out.u_alphabeta_V;
     v_applied_V_ = out.v_acting_AB_V;
   } else {
@@ -106,11 +168,15 @@ inline void Drive<T>::actuate(uint64_t k, const Estimate<T>& e, const Modulation
   }
   if (!hw_.pwm.enabled()) v_applied_V_ = Vec2::Zero();
   // The observers advance over [k, k+1] with the input acting on it.
-  if (e.valid) estimator_.advance(predictor_.written(v_applied_V_));
+  if (e.valid && model != nullptr) {
+    StateEstimator<T>& estimator =
+        substitutes_.estimator != nullptr ? *substitutes_.estimator : model->observers;
+    estimator.advance(model->predictor.written(v_applied_V_));
+  }
 }
 
 template <typename T>
-inline void Drive<T>::check_budget(uint64_t k, uint32_t counts) noexcept {
+inline void Drive<T>::check_budget(uint64_t k, uint32_t counts, MotorModel<T>* model) noexcept {
   const float exec_ns = float(counts) * ns_per_count_;  // within float's 2^-24
   record_.exec_ns = exec_ns < 4e9f ? static_cast<uint32_t>(exec_ns) : UINT32_MAX;
   execution_.add(record_.exec_ns);
@@ -119,25 +185,25 @@ inline void Drive<T>::check_budget(uint64_t k, uint32_t counts) noexcept {
   ++execution_.overruns;
   supervisor_.latch(overrun, k);
   pwm_off();                      // the PWM is off before the next period starts
-  predictor_.cancel_in_flight();  // so this tick's voltage never acts
+  if (model != nullptr) model->predictor.cancel_in_flight();  // this tick's voltage never acts
 }
 
 template <typename T>
 inline void Drive<T>::publish(uint64_t k, const Measurement<T>& m, const Estimate<T>& e,
                               const TickPlan<T>& plan, const LawOutput<T>& u,
-                              const Modulation<T>& out) noexcept {
+                              const Modulation<T>& out, MotorModel<T>* model) noexcept {
   TickRecord<T>& r = record_;
   r.tick = k;
   r.v_bus_V = m.v_bus_V;
   r.voltage_clipped = out.clipped;
-  if (e.valid) {
+  if (e.valid && model != nullptr) {
     const ControlledFlux flux = supervisor_.controlled_flux();
     r.i_alphabeta_A = m.i_alphabeta_A;
     r.omega_est_rad_s = e.x.omega_mech_rad_s;
     r.theta_est_rad = e.x.theta_mech_rad;
     r.flux_est_AB_Wb = e.x.flux_r_AB_Wb;
     r.flux2_est_Wb2 = e.x.flux_r_AB_Wb.squaredNorm();
-    r.controlled_flux2_Wb2 = magnetizer_.flux2_Wb2(e.x, flux);
+    r.controlled_flux2_Wb2 = model->magnetizer.flux2_Wb2(e.x, flux);
     r.load_est_Nm = e.load_Nm;
     r.i_s_est_AB_A = e.x.i_s_AB_A;
     r.v_AB_V = v_applied_V_;

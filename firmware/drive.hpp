@@ -8,7 +8,9 @@
 /// limits, SVPWM -> Modulation; protect: every trip decision -> Trip; actuate: the PWM write,
 /// or the PWM off in the same tick as a trip; publish: the tick record and CAN telemetry.
 /// Each stage is timed. T is the control arithmetic: float on the MCU, double on the host.
+#include <atomic>
 #include <cstdint>
+#include <optional>
 
 #include "control/motor_parameters.hpp"
 #include "control/voltage_fed_model.hpp"
@@ -16,6 +18,8 @@
 #include "firmware/drive_state.hpp"
 #include "firmware/execution_stats.hpp"
 #include "firmware/laws/law_registry.hpp"
+#include "firmware/motor_model.hpp"
+#include "firmware/parameters/parameter_bank.hpp"
 #include "firmware/protection/protection.hpp"
 #include "firmware/reference_source.hpp"
 #include "firmware/stages/estimate.hpp"
@@ -32,6 +36,7 @@
 #include "hal/current_adc.hpp"
 #include "hal/encoder.hpp"
 #include "hal/gpio.hpp"
+#include "hal/parameter_store.hpp"
 #include "hal/pwm.hpp"
 
 namespace imd::firmware {
@@ -44,6 +49,7 @@ struct DrivePeripherals {
   hal::ControlTimer& timer;
   hal::CanBus* can = nullptr;  ///< commands and telemetry; without it the drive is local only
   hal::Gpio* gpio = nullptr;   ///< the lines DriveConfig names (enable, fault, timing)
+  hal::ParameterStore* store = nullptr;  ///< where a save puts the motor record; none: refused
 };
 
 /// Parts that replace the drive's own, each optional (null: the board's part). A reference
@@ -60,13 +66,19 @@ struct DriveSubstitutes {
 template <typename T>
 class Drive final : public hal::TickHandler {
  public:
-  /// Wires the drive; no allocation after this.
-  Drive(const control::MotorParameters& motor, const DriveConfig& config,
+  /// Wires the drive; no allocation after this. `motor`: the record loaded from storage
+  /// (firmware/parameters/motor_record.hpp), valid; without one the drive waits, unconfigured,
+  /// for a record written over CAN.
+  Drive(const std::optional<control::MotorParameters>& motor, const DriveConfig& config,
         const DrivePeripherals& peripherals, const DriveSubstitutes<T>& substitutes = {});
   Drive(const Drive&) = delete;
   Drive& operator=(const Drive&) = delete;
 
   void on_tick() noexcept override;
+  /// What must not run in the tick: rebuilding the motor model after a parameter write, and
+  /// saving the record. The program calls it from its main loop, never from the tick; it
+  /// returns at once when nothing is pending. The tick does not touch the model meanwhile.
+  void service() noexcept;
   /// For a program that stops the drive (Linux: Ctrl-C, SIGTERM), after the last tick: turns the
   /// PWM off, goes to idle if modulating (reason shutdown; the motor coasts), and sends a final
   /// heartbeat. `k` is the tick count at the stop.
@@ -83,40 +95,52 @@ class Drive final : public hal::TickHandler {
   const ExecutionStats& execution() const noexcept { return execution_; }
   /// The rate of the execution clock that TickRecord::stage_counts are counted in.
   uint32_t execution_clock_Hz() const noexcept { return clock_Hz_; }
+  /// The motor record the drive runs on, if it has a complete one (not for tick context).
+  std::optional<control::MotorParameters> motor() const noexcept;
+  const ParameterBank& parameters() const noexcept { return bank_; }
 
  private:
   using Vec2 = control::Vec2<T>;
 
   // The stages are named functions for reading, and inlined into on_tick (each call of its
   // own costs ~1 % of the tick on the MCU).
-  [[gnu::always_inline]] Estimate<T> estimate(const Measurement<T>& m) noexcept;
+  /// The model the tick may use (null: none, or being rebuilt), attached on its arrival.
+  [[gnu::always_inline]] MotorModel<T>* model(uint64_t k) noexcept;
+  /// A parameter write asked for a new model: the tick lets go of the old one.
+  void release_model() noexcept;
+  [[gnu::always_inline]] Estimate<T> estimate(const Measurement<T>& m,
+                                              MotorModel<T>* model) noexcept;
   [[gnu::always_inline]] LawOutput<T> law(const TickPlan<T>& plan, const Estimate<T>& e,
-                                          T v_bus_V) noexcept;
+                                          T v_bus_V, MotorModel<T>* model) noexcept;
+  [[gnu::always_inline]] Modulation<T> modulate(const TickPlan<T>& plan, const LawOutput<T>& u,
+                                                const Estimate<T>& e, T v_bus_V,
+                                                MotorModel<T>* model) noexcept;
   /// The PWM write, or the PWM off with a fault latched; the observers learn what acts.
   [[gnu::always_inline]] void actuate(uint64_t k, const Estimate<T>& e, const Modulation<T>& out,
-                                      const Trip& trip) noexcept;
+                                      const Trip& trip, MotorModel<T>* model) noexcept;
   /// The execution time up to the PWM write, against its budget.
-  [[gnu::always_inline]] void check_budget(uint64_t k, uint32_t counts) noexcept;
+  [[gnu::always_inline]] void check_budget(uint64_t k, uint32_t counts,
+                                           MotorModel<T>* model) noexcept;
   [[gnu::always_inline]] void publish(uint64_t k, const Measurement<T>& m, const Estimate<T>& e,
                                       const TickPlan<T>& plan, const LawOutput<T>& u,
-                                      const Modulation<T>& out) noexcept;
+                                      const Modulation<T>& out, MotorModel<T>* model) noexcept;
+  static std::optional<MotorModel<T>> build(const std::optional<control::MotorParameters>& motor,
+                                            const DriveConfig& config, const BoardScales& board);
   void pwm_off() noexcept;
   /// Drives one of the board's output lines (nothing when the line is not wired).
   void write_line(int line, bool level) noexcept;
 
   DriveConfig config_;
   DrivePeripherals hw_;
-  control::VoltageFedCoefficients coefficients_;
+  DriveSubstitutes<T> substitutes_;
+  BoardScales board_;
   BoardSensing<T> board_sensing_;
   Sensing<T>& sensing_;
-  ObserverEstimator<T> observers_;
-  StateEstimator<T>& estimator_;
-  LatencyPredictor<T> predictor_;
-  LawRegistry<T> laws_;
-  Magnetizer<T> magnetizer_;
-  InputLimits<T> limits_;
-  SvpwmStage<T> svpwm_;
-  PowerStage<T>& power_stage_;
+  ParameterBank bank_;
+  /// Built outside the tick (construction, service); the tick uses it through attached_.
+  std::optional<MotorModel<T>> model_;
+  std::atomic<bool> model_ready_;  ///< model_ is whole: set by service, cleared by the tick
+  MotorModel<T>* attached_;        ///< tick side: the model in use, null while none
   Protection<T> protection_;
   Telemetry telemetry_;
   Supervisor<T> supervisor_;

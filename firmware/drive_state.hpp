@@ -15,8 +15,11 @@ enum class DriveState : uint8_t {
   running,      ///< the selected controller runs
   stopping,     ///< a disable command: ramp to a stop, then PWM off
   fault,        ///< PWM off, latched until clear_faults
+  /// PWM off, enable refused: no valid motor record yet, or the one just written is being
+  /// applied (the model is rebuilt outside the tick)
+  unconfigured,
 };
-inline constexpr int kDriveStateCount = 6;
+inline constexpr int kDriveStateCount = 7;
 
 enum class FaultCode : uint8_t {
   none = 0,
@@ -48,6 +51,8 @@ enum class TransitionReason : uint8_t {
   fault,
   clear_faults,
   shutdown,  ///< the program running the drive is ending (Linux host-in-the-loop)
+  parameters_written,  ///< a parameter write is being applied
+  configured,          ///< the motor model is built from a valid record
 };
 
 namespace detail {
@@ -76,5 +81,7 @@ static_assert(detail::same(state_name(DriveState::fault), "fault"));
 static_assert(detail::same(fault_name(FaultCode::overrun), "overrun"));
 static_assert(detail::same(fault_name(FaultCode::emergency_stop), "emergency_stop"));
 static_assert(detail::same(reason_name(TransitionReason::clear_faults), "clear_faults"));
+static_assert(detail::same(state_name(DriveState::unconfigured), "unconfigured"));
+static_assert(detail::same(reason_name(TransitionReason::configured), "configured"));
 
 }  // namespace imd::firmware

@@ -1,7 +1,10 @@
 #pragma once
 /// The drive's state machine:
 ///   calibrating -> idle -> magnetizing -> running -> stopping -> idle
-///   any state -> fault -> idle (only by clear_faults; to calibrating if the fault came first)
+///   calibrating -> unconfigured -> idle: no motor record, until a valid one is written
+///   idle -> unconfigured -> idle: a parameter write, while the model is rebuilt
+///   any state -> fault -> idle (only by clear_faults; to calibrating if the fault came first,
+///   to unconfigured without a motor record)
 ///   magnetizing, running or stopping -> idle by shutdown only (the program ends, PWM off)
 /// Every transition is checked against this graph, counted, and kept in a short log that the
 /// telemetry reports as state_change frames. No heap; tick context.
@@ -43,9 +46,11 @@ class StateMachine {
     if (to == S::fault) return from != S::fault;
     switch (from) {
       case S::calibrating:
-        return to == S::idle;
+        return to == S::idle || to == S::unconfigured;
       case S::idle:
-        return to == S::magnetizing;
+        return to == S::magnetizing || to == S::unconfigured;
+      case S::unconfigured:
+        return to == S::idle;
       case S::magnetizing:
         return to == S::running || to == S::idle;
       case S::running:
@@ -53,7 +58,7 @@ class StateMachine {
       case S::stopping:
         return to == S::idle;
       case S::fault:
-        return to == S::idle || to == S::calibrating;
+        return to == S::idle || to == S::calibrating || to == S::unconfigured;
     }
     return false;
   }

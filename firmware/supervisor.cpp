@@ -17,8 +17,8 @@ uint32_t saturated_ticks(uint64_t ticks) noexcept {
 
 template <typename T>
 Supervisor<T>::Supervisor(const DriveConfig& config, const SupervisorWiring& wiring,
-                          const ReferenceSource<T>* references, LawRegistry<T>& laws,
-                          const Magnetizer<T>& magnetizer, bool predicts_latency,
+                          const ReferenceSource<T>* references, LawRegistry<T>* laws,
+                          const Magnetizer<T>* magnetizer, bool predicts_latency,
                           bool calibrated) noexcept
     : commands_over_can_(config.commands_over_can),
       auto_enable_(config.auto_enable),
@@ -42,7 +42,7 @@ Supervisor<T>::Supervisor(const DriveConfig& config, const SupervisorWiring& wir
       calibrated_(calibrated) {
   select(config.controller);
   if (calibrated_) {
-    machine_.go(DriveState::idle, TransitionReason::calibrated, 0);
+    machine_.go(rest_state(), TransitionReason::calibrated, 0);
     TickPlan<T> unused;
     if (auto_enable_) enable(0, unused);
   }
@@ -50,11 +50,26 @@ Supervisor<T>::Supervisor(const DriveConfig& config, const SupervisorWiring& wir
 }
 
 template <typename T>
+void Supervisor<T>::attach(LawRegistry<T>* laws, const Magnetizer<T>* magnetizer,
+                           uint64_t k) noexcept {
+  laws_ = laws;
+  magnetizer_ = magnetizer;
+  if (laws_ == nullptr) return;
+  select(controller_);
+  if (machine_.go(DriveState::idle, TransitionReason::configured, k) && auto_enable_) {
+    TickPlan<T> unused;
+    enable(k, unused);
+  }
+  status_.state = machine_.state();
+}
+
+template <typename T>
 void Supervisor<T>::select(ControllerKind kind) noexcept {
   controller_ = kind;
+  status_.controller = static_cast<uint8_t>(kind);
+  if (laws_ == nullptr) return;  // the law's traits are read when a model is attached
   controlled_flux_ = law().controlled_flux();
   lookahead_ticks_ = law().lookahead_ticks();
-  status_.controller = static_cast<uint8_t>(kind);
 }
 
 template <typename T>
@@ -79,16 +94,16 @@ TickPlan<T> Supervisor<T>::plan(uint64_t k, const Measurement<T>& m,
   receive_commands(k, p);
   if (machine_.state() == DriveState::calibrating && m.calibration == Calibration::done) {
     calibrated_ = true;
-    machine_.go(DriveState::idle, TransitionReason::calibrated, k);
+    machine_.go(rest_state(), TransitionReason::calibrated, k);
     if (auto_enable_) enable(k + 1, p);
   }
   if (modulating() && e.valid) {
     references(k, e, p);
     const ControlledFlux flux = controlled_flux_;
     if (machine_.state() == DriveState::magnetizing) {
-      if (magnetizer_.magnetized(e.x, p.next, flux)) {
+      if (magnetizer_->magnetized(e.x, p.next, flux)) {
         machine_.go(DriveState::running, TransitionReason::magnetized, k);
-        law().start(e.x, magnetizer_.current_AB_A(e.x_input, p.next, flux));
+        law().start(e.x, magnetizer_->current_AB_A(e.x_input, p.next, flux));
       } else {
         p.mode = Mode::magnetizing;
       }

@@ -12,6 +12,7 @@
 #include "firmware/drive_config.hpp"
 #include "firmware/drive_state.hpp"
 #include "firmware/laws/law_registry.hpp"
+#include "firmware/parameters/parameter_bank.hpp"
 #include "firmware/protection/protection.hpp"
 #include "firmware/protection/trip.hpp"
 #include "firmware/protocol/commands.hpp"
@@ -49,16 +50,22 @@ struct SupervisorWiring {
   hal::CanBus* can = nullptr;
   hal::Gpio* gpio = nullptr;
   Telemetry& telemetry;
+  ParameterBank* parameters = nullptr;  ///< the motor record CAN reads and writes; none: refused
 };
 
 template <typename T>
 class Supervisor {
  public:
   /// `references`: the reference source unless the config takes references from CAN commands.
+  /// `laws`, `magnetizer`: the motor model's (null: no motor record yet).
   /// `calibrated`: the ADC offsets are known without a calibration.
   Supervisor(const DriveConfig& config, const SupervisorWiring& wiring,
-             const ReferenceSource<T>* references, LawRegistry<T>& laws,
-             const Magnetizer<T>& magnetizer, bool predicts_latency, bool calibrated) noexcept;
+             const ReferenceSource<T>* references, LawRegistry<T>* laws,
+             const Magnetizer<T>* magnetizer, bool predicts_latency, bool calibrated) noexcept;
+
+  /// A new motor model is in use (unconfigured -> idle), or none (null: the drive is
+  /// unconfigured until one arrives).
+  void attach(LawRegistry<T>* laws, const Magnetizer<T>* magnetizer, uint64_t k) noexcept;
 
   /// Commands, then the transitions the measurement and the estimate call for, then the
   /// references.
@@ -75,8 +82,9 @@ class Supervisor {
   DriveStatus& status() noexcept { return status_; }
   const StateMachine& machine() const noexcept { return machine_; }
   const protocol::CommandDecoder& decoder() const noexcept { return decoder_; }
-  ControlLaw<T>& law() noexcept { return laws_.law(controller_); }
-  const ControlLaw<T>& law() const noexcept { return laws_.law(controller_); }
+  /// The selected law; only while a motor model is attached (configured).
+  ControlLaw<T>& law() noexcept { return laws_->law(controller_); }
+  const ControlLaw<T>& law() const noexcept { return laws_->law(controller_); }
   /// The selected law's flux (kept at selection: the tick asks for it several times).
   ControlledFlux controlled_flux() const noexcept { return controlled_flux_; }
 
@@ -90,14 +98,20 @@ class Supervisor {
   void clear_faults(uint64_t k, TickPlan<T>& p) noexcept;
   bool read_enable_input() const noexcept;
   void select(ControllerKind kind) noexcept;
-
+  /// The state the drive rests in once calibrated: idle, or unconfigured without a model.
+  DriveState rest_state() const noexcept {
+    return laws_ != nullptr ? DriveState::idle : DriveState::unconfigured;
+  }
+  protocol::CommandResult access_parameter(const protocol::Command& c, uint64_t k,
+                                           TickPlan<T>& p) noexcept;
+  void answer_parameter(uint8_t field, protocol::ParameterOp op, ParameterStatus status) noexcept;
   bool commands_over_can_, auto_enable_;
   int enable_input_line_;
   SupervisorWiring wiring_;
   CommandedReference<T> commanded_;
   const ReferenceSource<T>& references_;  ///< commanded_ or the given source
-  LawRegistry<T>& laws_;
-  const Magnetizer<T>& magnetizer_;
+  LawRegistry<T>* laws_;
+  const Magnetizer<T>* magnetizer_;
   bool predicts_latency_;
   ControllerKind controller_;
   ControlledFlux controlled_flux_;  ///< of the selected law

@@ -1,6 +1,7 @@
 // The supervisor's command handling: frames from CAN, checked by the protocol decoder, applied
 // to the state machine and the references. Tick context, bounded work per tick.
 #include <cmath>
+#include <limits>
 
 #include "firmware/supervisor.hpp"
 
@@ -12,6 +13,11 @@ inline constexpr int kMaxFramesPerTick = 4;
 template <typename T>
 void Supervisor<T>::receive_commands(uint64_t k, TickPlan<T>& p) noexcept {
   if (wiring_.can == nullptr) return;
+  if (wiring_.parameters != nullptr) {
+    if (const auto saved = wiring_.parameters->take_outcome()) {
+      answer_parameter(0, protocol::ParameterOp::save, *saved);
+    }
+  }
   hal::CanFrame frame;
   for (int n = 0; n < kMaxFramesPerTick && wiring_.can->try_receive(frame); ++n) {
     protocol::Decoded d = decoder_.decode(frame);
@@ -37,7 +43,7 @@ void Supervisor<T>::enable(uint64_t k, TickPlan<T>& p) noexcept {
 template <typename T>
 void Supervisor<T>::clear_faults(uint64_t k, TickPlan<T>& p) noexcept {
   // A fault during the offset calibration leaves the offsets unknown: calibrate again.
-  const DriveState next = calibrated_ ? DriveState::idle : DriveState::calibrating;
+  const DriveState next = calibrated_ ? rest_state() : DriveState::calibrating;
   if (!machine_.go(next, TransitionReason::clear_faults, k)) return;
   status_.fault_bits = 0;
   status_.first_fault = FaultCode::none;
@@ -93,8 +99,9 @@ protocol::CommandResult Supervisor<T>::apply(const protocol::Command& c, uint64_
       const long index = std::lround(c.value);
       if (index < 0 || index >= kControllerCount) return CommandResult::out_of_range;
       const auto wanted = static_cast<ControllerKind>(index);
+      if (laws_ == nullptr) return CommandResult::not_allowed;  // no motor model
       // Only at rest; a law that follows no speed reference only with references of its own.
-      const bool speed_capable = laws_.law(wanted).follows_speed() || !commands_over_can_;
+      const bool speed_capable = laws_->law(wanted).follows_speed() || !commands_over_can_;
       if (s != DriveState::idle || !speed_capable) return CommandResult::not_allowed;
       select(wanted);
       return CommandResult::accepted;
@@ -103,8 +110,63 @@ protocol::CommandResult Supervisor<T>::apply(const protocol::Command& c, uint64_
       return wiring_.telemetry.set_rate_Hz(static_cast<int>(std::lround(c.value)))
                  ? CommandResult::accepted
                  : CommandResult::out_of_range;
+    case CommandKind::parameter_access:
+      return access_parameter(c, k, p);
   }
   return CommandResult::unknown_message;
+}
+
+template <typename T>
+protocol::CommandResult Supervisor<T>::access_parameter(const protocol::Command& c, uint64_t k,
+                                                        TickPlan<T>&) noexcept {
+  using protocol::CommandResult;
+  using protocol::ParameterOp;
+  ParameterBank* bank = wiring_.parameters;
+  if (bank == nullptr) return CommandResult::not_allowed;
+  ParameterStatus status = ParameterStatus::ok;
+  switch (c.op) {
+    case ParameterOp::read: {
+      double value = 0.0;
+      status = bank->read(c.field, value);
+      break;
+    }
+    case ParameterOp::write: {
+      const DriveState s = machine_.state();
+      const bool at_rest = s == DriveState::idle || s == DriveState::unconfigured;
+      status = bank->write(c.field, double(c.value), at_rest);
+      // The model is rebuilt outside the tick: the drive is unconfigured until it is whole.
+      if (status == ParameterStatus::ok && bank->apply_wanted() && s == DriveState::idle) {
+        machine_.go(DriveState::unconfigured, TransitionReason::parameters_written, k);
+        status_.state = machine_.state();
+      }
+      break;
+    }
+    case ParameterOp::save:
+      status = bank->save();
+      if (status == ParameterStatus::ok) return CommandResult::accepted;  // answered when done
+      break;
+  }
+  answer_parameter(c.field, c.op, status);
+  switch (status) {
+    case ParameterStatus::ok: return CommandResult::accepted;
+    case ParameterStatus::not_idle:
+    case ParameterStatus::busy:
+    case ParameterStatus::not_set: return CommandResult::not_allowed;
+    default: return CommandResult::out_of_range;
+  }
+}
+
+template <typename T>
+void Supervisor<T>::answer_parameter(uint8_t field, protocol::ParameterOp op,
+                                     ParameterStatus status) noexcept {
+  const ParameterBank* bank = wiring_.parameters;
+  if (wiring_.can == nullptr || bank == nullptr) return;
+  double value = std::numeric_limits<double>::quiet_NaN();
+  // The value after the operation: the new one, or the unchanged one of a refused write.
+  const ParameterStatus read = bank->read(field, value);
+  if (read != ParameterStatus::ok) value = std::numeric_limits<double>::quiet_NaN();
+  wiring_.telemetry.parameter_value(*wiring_.can, field, op, static_cast<uint8_t>(status),
+                                    static_cast<float>(value), bank->complete(), bank->saved());
 }
 
 // The class is instantiated in supervisor.cpp; these members are defined here.
@@ -113,7 +175,11 @@ protocol::CommandResult Supervisor<T>::apply(const protocol::Command& c, uint64_
   template void Supervisor<T>::enable(uint64_t, TickPlan<T>&) noexcept;                     \
   template void Supervisor<T>::clear_faults(uint64_t, TickPlan<T>&) noexcept;               \
   template protocol::CommandResult Supervisor<T>::apply(const protocol::Command&, uint64_t, \
-                                                        TickPlan<T>&) noexcept;
+                                                        TickPlan<T>&) noexcept;            \
+  template protocol::CommandResult Supervisor<T>::access_parameter(                         \
+      const protocol::Command&, uint64_t, TickPlan<T>&) noexcept;                           \
+  template void Supervisor<T>::answer_parameter(uint8_t, protocol::ParameterOp,             \
+                                                ParameterStatus) noexcept;
 IMD_INSTANTIATE_COMMANDS(float)
 IMD_INSTANTIATE_COMMANDS(double)
 #undef IMD_INSTANTIATE_COMMANDS

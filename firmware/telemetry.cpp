@@ -143,4 +143,11 @@ void Telemetry::acknowledge(hal::CanBus& can, const protocol::Decoded& decoded,
                           float(std::min<uint32_t>(rejected_total, 0xFFFF))}));
 }
 
+void Telemetry::parameter_value(hal::CanBus& can, uint8_t field, protocol::ParameterOp op,
+                                uint8_t status, float value, bool complete, bool saved) noexcept {
+  send(can, encode_frame(node_id_, MessageId::parameter_value,
+                         {float(field), float(op), float(status), value, complete ? 1.0f : 0.0f,
+                          saved ? 1.0f : 0.0f}));
+}
+
 }  // namespace imd::firmware

@@ -54,6 +54,10 @@ class Telemetry {
   void acknowledge(hal::CanBus& can, const protocol::Decoded& decoded,
                    uint32_t rejected_total) noexcept;
 
+  /// The parameter_value frame: the answer to a parameter_access.
+  void parameter_value(hal::CanBus& can, uint8_t field, protocol::ParameterOp op, uint8_t status,
+                       float value, bool complete, bool saved) noexcept;
+
   uint32_t dropped_frames() const noexcept { return dropped_; }
 
  private:

@@ -43,23 +43,26 @@ typename EncoderCheck<T>::Config encoder_config(const control::MotorParameters& 
 }  // namespace
 
 template <typename T>
-Protection<T>::Protection(const control::MotorParameters& motor, const DriveConfig& config,
-                          double counts_per_rev, double adc_A_per_code) noexcept
+MotorChecks<T>::MotorChecks(const control::MotorParameters& motor, const DriveConfig& config,
+                            double counts_per_rev, double adc_A_per_code) noexcept
+    : pole_pairs(T(motor.pole_pairs)),
+      torque_per_AWb(T(control::kClarkeTorqueFactor * motor.pole_pairs * motor.Lm_H / motor.Lr_H)),
+      encoder(encoder_config<T>(motor, config, counts_per_rev)),
+      adc_stuck(config.protection.adc_stuck_ticks, config.sample_period_s,
+                control::derive_voltage_fed(motor).sigma_H, adc_A_per_code) {}
+
+template <typename T>
+Protection<T>::Protection(const DriveConfig& config) noexcept
     : config_(config.protection),
       commands_over_can_(config.commands_over_can),
       overcurrent_A_(T(config.protection.overcurrent_A)),
       bus_min_V_(T(config.protection.bus_min_V)),
       bus_max_V_(T(config.protection.bus_max_V)),
       overspeed_rad_s_(T(config.protection.overspeed_rad_s)),
-      pole_pairs_(T(motor.pole_pairs)),
-      torque_per_AWb_(T(control::kClarkeTorqueFactor * motor.pole_pairs * motor.Lm_H / motor.Lr_H)),
       magnetizing_timeout_ticks_(
           saturated(duration_ticks(config.magnetizing_timeout_s, config.sample_period_s))),
       command_timeout_ticks_(
           saturated(duration_ticks(config.protection.command_timeout_s, config.sample_period_s))),
-      encoder_check_(encoder_config<T>(motor, config, counts_per_rev)),
-      adc_stuck_check_(config.protection.adc_stuck_ticks, config.sample_period_s,
-                       control::derive_voltage_fed(motor).sigma_H, adc_A_per_code),
       phase_loss_check_(config.protection.phase_loss_ratio,
                         config.protection.phase_loss_min_current_A,
                         static_cast<uint32_t>(duration_ticks(
@@ -74,11 +77,10 @@ void Protection<T>::set_clock(uint32_t clock_Hz) noexcept {
 template <typename T>
 Trip Protection<T>::check(const Measurement<T>& m, const Estimate<T>& e, const SupervisedState& s,
                           const LawOutput<T>& law, const Modulation<T>& out,
-                          const control::Vec2<T>& u_last_V) noexcept {
+                          const control::Vec2<T>& u_last_V, MotorChecks<T>* motor) noexcept {
   Trip trip;
   if (s.restarted) {
-    encoder_check_.reset();
-    adc_stuck_check_.reset();
+    if (motor != nullptr) motor->reset();
     phase_loss_check_.reset();
   }
   if (!s.enable_input && s.modulating) trip.add(FaultCode::enable_input);
@@ -86,13 +88,13 @@ Trip Protection<T>::check(const Measurement<T>& m, const Estimate<T>& e, const S
     trip.add(FaultCode::adc_offset, m.offset_fault_phase);
   }
   if (!m.valid) return trip;  // nothing measured: calibrating, or offsets unknown
-  check_sensed(m, e, s.modulating, trip);
-  if (!s.modulating || trip.any()) {
-    adc_stuck_check_.reset();
+  check_sensed(m, e, s.modulating, motor, trip);
+  if (!s.modulating || motor == nullptr || trip.any()) {
+    if (motor != nullptr) motor->adc_stuck.reset();
     phase_loss_check_.reset();
     return trip;
   }
-  check_driving(m, e, s, u_last_V, trip);
+  check_driving(m, e, s, u_last_V, *motor, trip);
   if (trip.any()) return trip;
   if (s.magnetizing && s.magnetizing_ticks > magnetizing_timeout_ticks_) {
     trip.add(FaultCode::magnetizing_timeout);
@@ -105,7 +107,8 @@ Trip Protection<T>::check(const Measurement<T>& m, const Estimate<T>& e, const S
 
 template <typename T>
 inline void Protection<T>::check_sensed(const Measurement<T>& m, const Estimate<T>& e,
-                                        bool modulating, Trip& trip) noexcept {
+                                        bool modulating, MotorChecks<T>* motor,
+                                        Trip& trip) noexcept {
   if (m.i_peak_A > overcurrent_A_ || m.adc_saturated) {
     int phase = 0;
     for (int i = 1; i < 3; ++i) {
@@ -119,10 +122,11 @@ inline void Protection<T>::check_sensed(const Measurement<T>& m, const Estimate<
       !std::isfinite(e.load_Nm)) {
     trip.add(FaultCode::non_finite);
   }
+  if (motor == nullptr) return;  // no motion model to judge the encoder by
   const bool driving = modulating && !trip.any();  // a fault has turned the PWM off
   const T torque_Nm =
-      driving ? torque_per_AWb_ * control::dot_J<T>(e.x.i_s_AB_A, e.x.flux_r_AB_Wb) : T(0);
-  if (config_.check_encoder && encoder_check_.failed(m.encoder_delta_counts, e.x.omega_mech_rad_s,
+      driving ? motor->torque_per_AWb * control::dot_J<T>(e.x.i_s_AB_A, e.x.flux_r_AB_Wb) : T(0);
+  if (config_.check_encoder && motor->encoder.failed(m.encoder_delta_counts, e.x.omega_mech_rad_s,
                                                      e.load_Nm, torque_Nm, driving)) {
     trip.add(FaultCode::encoder);
   }
@@ -131,13 +135,13 @@ inline void Protection<T>::check_sensed(const Measurement<T>& m, const Estimate<
 template <typename T>
 inline void Protection<T>::check_driving(const Measurement<T>& m, const Estimate<T>& e,
                                          const SupervisedState& s, const control::Vec2<T>& u_last_V,
-                                         Trip& trip) noexcept {
+                                         MotorChecks<T>& motor, Trip& trip) noexcept {
   if (!(m.v_bus_V >= bus_min_V_)) trip.add(FaultCode::bus_undervoltage);  // NaN too
-  if (config_.check_adc_stuck && adc_stuck_check_.stuck(m.phase_code, u_last_V)) {
+  if (config_.check_adc_stuck && motor.adc_stuck.stuck(m.phase_code, u_last_V)) {
     trip.add(FaultCode::adc_stuck);
   }
   const T flux_angle_rad =
-      pole_pairs_ * e.x.theta_mech_rad + std::atan2(e.x.flux_r_AB_Wb.y(), e.x.flux_r_AB_Wb.x());
+      motor.pole_pairs * e.x.theta_mech_rad + std::atan2(e.x.flux_r_AB_Wb.y(), e.x.flux_r_AB_Wb.x());
   const int lost = phase_loss_check_.lost_phase(m.i_abc_A, flux_angle_rad);
   if (lost >= 0) trip.add(FaultCode::phase_loss, uint8_t(lost));
   if (commands_over_can_ && command_timeout_ticks_ > 0 && s.watchdog_armed &&
@@ -153,6 +157,8 @@ Trip Protection<T>::over_budget(uint32_t exec_counts) const noexcept {
   return trip;
 }
 
+template struct MotorChecks<float>;
+template struct MotorChecks<double>;
 template class Protection<float>;
 template class Protection<double>;
 

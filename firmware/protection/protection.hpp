@@ -38,16 +38,33 @@ struct SupervisedState {
   uint32_t command_silence_ticks = 0;  ///< since the last valid command (saturates)
 };
 
+/// The checks built from the motor parameters: they are part of the motor model, rebuilt with
+/// it (firmware/motor_model.hpp). Without them (no motor record) the drive cannot modulate, and
+/// the encoder check, which needs the motor's motion model, is skipped.
+template <typename T>
+struct MotorChecks {
+  /// `counts_per_rev`, `adc_A_per_code`: the board's encoder and ADC.
+  MotorChecks(const control::MotorParameters& motor, const DriveConfig& config,
+              double counts_per_rev, double adc_A_per_code) noexcept;
+  void reset() noexcept {
+    encoder.reset();
+    adc_stuck.reset();
+  }
+
+  T pole_pairs, torque_per_AWb;
+  EncoderCheck<T> encoder;
+  AdcStuckCheck<T> adc_stuck;
+};
+
 template <typename T>
 class Protection {
  public:
-  /// `counts_per_rev`, `adc_A_per_code`: the board's encoder and ADC.
-  Protection(const control::MotorParameters& motor, const DriveConfig& config,
-             double counts_per_rev, double adc_A_per_code) noexcept;
+  explicit Protection(const DriveConfig& config) noexcept;
 
+  /// `motor`: the motor model's checks, null without a motor record.
   Trip check(const Measurement<T>& m, const Estimate<T>& e, const SupervisedState& s,
-             const LawOutput<T>& law, const Modulation<T>& out,
-             const control::Vec2<T>& u_last_V) noexcept;
+             const LawOutput<T>& law, const Modulation<T>& out, const control::Vec2<T>& u_last_V,
+             MotorChecks<T>* motor) noexcept;
   /// The tick took `exec_counts` of the execution clock: an overrun past the budget.
   Trip over_budget(uint32_t exec_counts) const noexcept;
   /// The budget in execution-clock counts (0: not checked), for a clock of `clock_Hz`.
@@ -55,19 +72,18 @@ class Protection {
 
  private:
   [[gnu::always_inline]] void check_sensed(const Measurement<T>& m, const Estimate<T>& e,
-                                           bool modulating, Trip& trip) noexcept;
+                                           bool modulating, MotorChecks<T>* motor,
+                                           Trip& trip) noexcept;
   [[gnu::always_inline]] void check_driving(const Measurement<T>& m, const Estimate<T>& e,
                                             const SupervisedState& s,
-                                            const control::Vec2<T>& u_last_V, Trip& trip) noexcept;
+                                            const control::Vec2<T>& u_last_V,
+                                            MotorChecks<T>& motor, Trip& trip) noexcept;
 
   ProtectionConfig config_;
   bool commands_over_can_;
   T overcurrent_A_, bus_min_V_, bus_max_V_, overspeed_rad_s_;
-  T pole_pairs_, torque_per_AWb_;
   uint32_t magnetizing_timeout_ticks_, command_timeout_ticks_;
   uint32_t budget_counts_ = 0;
-  EncoderCheck<T> encoder_check_;
-  AdcStuckCheck<T> adc_stuck_check_;
   PhaseLossCheck<T> phase_loss_check_;
 };
 

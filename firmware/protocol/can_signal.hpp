@@ -3,6 +3,7 @@
 /// physical = raw * scale + offset, with scale = scale_num / scale_den so that the DBC shows it
 /// exactly and the MCU packs it in single precision. No heap; usable in tick context.
 #include <array>
+#include <bit>
 #include <cmath>
 #include <cstdint>
 #include <span>
@@ -26,6 +27,9 @@ struct Signal {
   const char* unit = "";
   const char* comment = "";
   std::span<const ValueName> values = {};
+  /// An IEEE 754 single-precision value in 32 bits (a DBC SIG_VALTYPE_ 1 signal); the scale is
+  /// 1 and the offset 0.
+  bool is_float = false;
 
   constexpr double scale() const noexcept { return double(scale_num) / double(scale_den); }
   constexpr int64_t raw_min() const noexcept {
@@ -60,6 +64,7 @@ constexpr void set_raw(Payload& data, const Signal& s, int64_t raw) noexcept {
 
 /// The physical value of a signal, in single precision (what the MCU decodes with).
 inline float get_physical(const Payload& data, const Signal& s) noexcept {
+  if (s.is_float) return std::bit_cast<float>(static_cast<uint32_t>(get_raw(data, s)));
   return float(get_raw(data, s)) * float(s.scale_num) / float(s.scale_den) + s.offset;
 }
 
@@ -85,11 +90,16 @@ inline int64_t to_raw(const Signal& s, float value) noexcept {
 }
 
 inline void set_physical(Payload& data, const Signal& s, float value) noexcept {
+  if (s.is_float) {
+    set_raw(data, s, std::bit_cast<uint32_t>(value));  // NaN and infinities pass as they are
+    return;
+  }
   set_raw(data, s, to_raw(s, value));
 }
 
-/// Whether a physical value is representable without saturation.
+/// Whether a physical value is representable without saturation (any float in a float signal).
 inline bool in_range(const Signal& s, float value) noexcept {
+  if (s.is_float) return true;
   const float raw = std::round((value - s.offset) * float(s.scale_den) / float(s.scale_num));
   return raw >= float(s.raw_min()) && raw <= float(s.raw_max());
 }

@@ -37,6 +37,8 @@ MessageId message_for(CommandKind kind) noexcept {
       return MessageId::select_controller;
     case CommandKind::set_telemetry_rate:
       return MessageId::set_telemetry_rate;
+    case CommandKind::parameter_access:
+      return MessageId::parameter_access;
   }
   return MessageId::disable;
 }
@@ -116,6 +118,19 @@ Decoded CommandDecoder::decode(const hal::CanFrame& frame) noexcept {
         return reject(d, CommandResult::out_of_range);
       }
       break;
+    case MessageId::parameter_access: {
+      // The field and the value are the application's to judge (it answers with a reason);
+      // an operation the protocol does not define is a malformed frame.
+      const Message& pa = message(MessageId::parameter_access);
+      c.kind = CommandKind::parameter_access;
+      const int64_t op = get_raw(frame.data, pa.signals[2]);
+      if (op >= kParameterOpCount) return reject(d, CommandResult::out_of_range);
+      c.op = static_cast<ParameterOp>(op);
+      c.field = static_cast<uint8_t>(get_raw(frame.data, pa.signals[3]));
+      c.value = get_physical(frame.data, pa.signals[4]);
+      d.result = CommandResult::accepted;
+      return d;
+    }
     default:
       return reject(d, CommandResult::unknown_message);
   }
@@ -131,7 +146,13 @@ hal::CanFrame CommandEncoder::encode(const Command& command) noexcept {
   hal::CanFrame frame;
   frame.id = can_id(node_id_, id);
   frame.length = m.length;
-  if (m.signals.size() > 2) set_physical(frame.data, m.signals[2], command.value);
+  if (id == MessageId::parameter_access) {
+    set_raw(frame.data, m.signals[2], static_cast<int64_t>(command.op));
+    set_raw(frame.data, m.signals[3], command.field);
+    set_physical(frame.data, m.signals[4], command.value);
+  } else if (m.signals.size() > 2) {
+    set_physical(frame.data, m.signals[2], command.value);
+  }
   e2e_protect(frame.id, frame.data, frame.length, counter_);
   counter_ = static_cast<uint8_t>((counter_ + 1) & 0x0F);
   return frame;

@@ -24,13 +24,20 @@ enum class CommandKind : uint8_t {
   clear_faults,
   set_speed,           ///< value: rad/s
   set_flux,            ///< value: Wb^2
-  select_controller,   ///< value: 0 dsmc, 1 iol
+  select_controller,   ///< value: 0 dsmc, 1 iol, 2 ifoc
   set_telemetry_rate,  ///< value: Hz
+  parameter_access,    ///< op (read, write, save), field, value (write)
 };
+
+/// What a parameter_access frame asks (kParameterOpValues).
+enum class ParameterOp : uint8_t { read, write, save };
+inline constexpr int kParameterOpCount = 3;
 
 struct Command {
   CommandKind kind = CommandKind::disable;
   float value = 0.0f;
+  ParameterOp op = ParameterOp::read;  ///< parameter_access only
+  uint8_t field = 0;                   ///< parameter_access only: the record's field index
 };
 
 /// Why a frame was rejected (the numbering is kCommandResultValues').

@@ -26,6 +26,7 @@ inline hal::CanFrame encode_frame(uint8_t node_id, MessageId id,
 
 /// The physical value of signal `index` of a frame, in double precision (host tools).
 inline double decode_signal(const hal::CanFrame& frame, const Signal& s) noexcept {
+  if (s.is_float) return double(get_physical(frame.data, s));
   return double(get_raw(frame.data, s)) * s.scale() + double(s.offset);
 }
 

@@ -30,6 +30,8 @@ enum class MessageId : uint8_t {
   set_telemetry_rate = 0x0A,
   command_ack = 0x0B,
   state_change = 0x0C,
+  parameter_access = 0x0D,
+  parameter_value = 0x0E,
   telemetry_speed_flux = 0x10,
   telemetry_current = 0x11,
   telemetry_voltage = 0x12,
@@ -78,6 +80,7 @@ constexpr uint8_t message_of(uint16_t can_id) noexcept {
 inline constexpr ValueName kStateValues[] = {
     {0, "calibrating"}, {1, "idle"},     {2, "magnetizing"},
     {3, "running"},     {4, "stopping"}, {5, "fault"},
+    {6, "unconfigured"},
 };
 inline constexpr ValueName kFaultValues[] = {
     {0, "none"},
@@ -105,6 +108,17 @@ inline constexpr ValueName kCommandResultValues[] = {
 inline constexpr ValueName kTransitionReasonValues[] = {
     {0, "calibrated"}, {1, "enable"}, {2, "magnetized"},   {3, "disable"},
     {4, "stopped"},    {5, "fault"},  {6, "clear_faults"}, {7, "shutdown"},
+    {8, "parameters_written"}, {9, "configured"},
+};
+inline constexpr ValueName kMotorFieldValues[] = {
+    {0, "Rs_Ohm"}, {1, "Ls_H"},   {2, "Lm_H"},       {3, "Rr_Ohm"},
+    {4, "Lr_H"},   {5, "J_kgm2"}, {6, "pole_pairs"}, {7, "friction_Nms"},
+};
+inline constexpr ValueName kParameterOpValues[] = {{0, "read"}, {1, "write"}, {2, "save"}};
+inline constexpr ValueName kParameterStatusValues[] = {
+    {0, "ok"},         {1, "not_idle"},  {2, "unknown_field"}, {3, "not_finite"},
+    {4, "not_positive"}, {5, "negative"}, {6, "not_whole"},     {7, "no_leakage"},
+    {8, "not_set"},    {9, "store_failed"}, {10, "busy"},
 };
 
 // --- the E2E header every command starts with
@@ -162,6 +176,24 @@ inline constexpr Signal kStateChangeSignals[] = {
     {"reason", 16, 8, false, 1, 1, 0.0f, "", "why", kTransitionReasonValues},
     {"transitions", 24, 8, false, 1, 1, 0.0f, "", "state transitions, wraps"},
     {"time_ms", 32, 32, false, 1, 1, 0.0f, "ms", "drive time of the transition"},
+};
+inline constexpr Signal kParameterAccessSignals[] = {
+    kE2eCrc,
+    kE2eCounter,
+    {"op", 12, 4, false, 1, 1, 0.0f, "", "read, write (only while idle) or save the record",
+     kParameterOpValues},
+    {"field", 16, 8, false, 1, 1, 0.0f, "", "the record's field (read, write)", kMotorFieldValues},
+    {"value", 24, 32, false, 1, 1, 0.0f, "", "the new value in the field's unit (write)", {},
+     true},
+};
+inline constexpr Signal kParameterValueSignals[] = {
+    {"field", 0, 8, false, 1, 1, 0.0f, "", "the record's field", kMotorFieldValues},
+    {"op", 8, 4, false, 1, 1, 0.0f, "", "the operation answered", kParameterOpValues},
+    {"status", 12, 4, false, 1, 1, 0.0f, "", "ok, or why the operation was refused",
+     kParameterStatusValues},
+    {"value", 16, 32, false, 1, 1, 0.0f, "", "the field's value after the operation", {}, true},
+    {"complete", 48, 1, false, 1, 1, 0.0f, "", "every field has a valid value: the drive runs on it"},
+    {"saved", 49, 1, false, 1, 1, 0.0f, "", "the record in use is the one in storage"},
 };
 inline constexpr Signal kSpeedFluxSignals[] = {
     {"speed_rad_s", 0, 16, true, 1, 100, 0.0f, "rad/s", "estimated mechanical speed"},
@@ -227,6 +259,12 @@ inline constexpr Message kMessages[] = {
      "the result of every command frame addressed to this node", kCommandAckSignals},
     {MessageId::state_change, "state_change", 8, Direction::drive_to_host, Timing::on_event, 0,
      "sent on every state transition", kStateChangeSignals},
+    {MessageId::parameter_access, "parameter_access", 7, Direction::host_to_drive,
+     Timing::on_event, 0, "read or write a motor parameter, or save the record",
+     kParameterAccessSignals},
+    {MessageId::parameter_value, "parameter_value", 7, Direction::drive_to_host, Timing::on_event,
+     0, "the answer to every parameter_access: the value or why it was refused",
+     kParameterValueSignals},
     {MessageId::telemetry_speed_flux, "telemetry_speed_flux", 8, Direction::drive_to_host,
      Timing::configurable, 10, "fast telemetry 1/3", kSpeedFluxSignals},
     {MessageId::telemetry_current, "telemetry_current", 8, Direction::drive_to_host,

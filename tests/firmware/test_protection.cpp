@@ -13,6 +13,18 @@ namespace {
 
 using Vec2 = control::Vec2<double>;
 
+/// The protect stage with the checks of a motor model (the drive passes them each tick).
+struct MotorProtection {
+  Protection<double> protection;
+  MotorChecks<double> motor;
+  Trip check(const Measurement<double>& m, const Estimate<double>& e, const SupervisedState& s,
+             const LawOutput<double>& law, const Modulation<double>& out, const Vec2& u_last_V) {
+    return protection.check(m, e, s, law, out, u_last_V, &motor);
+  }
+  void set_clock(uint32_t clock_Hz) { protection.set_clock(clock_Hz); }
+  Trip over_budget(uint32_t counts) const { return protection.over_budget(counts); }
+};
+
 struct Bench {
   DriveConfig config;
   Measurement<double> m;
@@ -35,18 +47,21 @@ struct Bench {
     e.x.flux_r_AB_Wb = Vec2(0.45, 0.0);
     s.modulating = true;
   }
-  Protection<double> make() const { return {test::paper_motor(), config, 8192.0, 10.0 / 2048}; }
+  MotorProtection make() const {
+    return {Protection<double>(config),
+            MotorChecks<double>(test::paper_motor(), config, 8192.0, 10.0 / 2048)};
+  }
 };
 
 TEST(Protection, AHealthyTickTripsNothing) {
   Bench b;
-  Protection<double> p = b.make();
+  MotorProtection p = b.make();
   EXPECT_FALSE(p.check(b.m, b.e, b.s, b.law, b.out, Vec2::Zero()).any());
 }
 
 TEST(Protection, TheFirstFaultIsNamedAndEveryFaultIsCounted) {
   Bench b;
-  Protection<double> p = b.make();
+  MotorProtection p = b.make();
   b.m.i_abc_A[1] = -9.5;  // phase b past the 9 A trip
   b.m.i_peak_A = 9.5;
   b.m.v_bus_V = 500.0;
@@ -59,14 +74,14 @@ TEST(Protection, TheFirstFaultIsNamedAndEveryFaultIsCounted) {
 
 TEST(Protection, ARailCodeIsOvercurrent) {
   Bench b;
-  Protection<double> p = b.make();
+  MotorProtection p = b.make();
   b.m.adc_saturated = true;
   EXPECT_EQ(p.check(b.m, b.e, b.s, b.law, b.out, Vec2::Zero()).first, FaultCode::overcurrent);
 }
 
 TEST(Protection, UndervoltageIsJudgedOnlyWhileDriving) {
   Bench b;
-  Protection<double> p = b.make();
+  MotorProtection p = b.make();
   b.m.v_bus_V = 150.0;
   b.s.modulating = false;
   EXPECT_FALSE(p.check(b.m, b.e, b.s, b.law, b.out, Vec2::Zero()).any());
@@ -78,7 +93,7 @@ TEST(Protection, UndervoltageIsJudgedOnlyWhileDriving) {
 
 TEST(Protection, TheEnableInputMattersOnlyWhileDriving) {
   Bench b;
-  Protection<double> p = b.make();
+  MotorProtection p = b.make();
   b.s.enable_input = false;
   b.s.modulating = false;
   EXPECT_FALSE(p.check(b.m, b.e, b.s, b.law, b.out, Vec2::Zero()).any());
@@ -88,7 +103,7 @@ TEST(Protection, TheEnableInputMattersOnlyWhileDriving) {
 
 TEST(Protection, WhileCalibratingOnlyTheOffsetIsJudged) {
   Bench b;
-  Protection<double> p = b.make();
+  MotorProtection p = b.make();
   b.m.valid = false;
   b.m.i_peak_A = 100.0;  // not a measurement: ignored
   b.m.calibration = Calibration::offset_fault;
@@ -101,7 +116,7 @@ TEST(Protection, WhileCalibratingOnlyTheOffsetIsJudged) {
 
 TEST(Protection, MagnetizingTimesOutAfterItsTicks) {
   Bench b;
-  Protection<double> p = b.make();
+  MotorProtection p = b.make();
   b.s.magnetizing = true;
   b.s.magnetizing_ticks = 100;
   EXPECT_FALSE(p.check(b.m, b.e, b.s, b.law, b.out, Vec2::Zero()).any());
@@ -112,7 +127,7 @@ TEST(Protection, MagnetizingTimesOutAfterItsTicks) {
 
 TEST(Protection, ALawWithoutSolutionAndANonFiniteOutputTrip) {
   Bench b;
-  Protection<double> p = b.make();
+  MotorProtection p = b.make();
   b.law.ok = false;
   b.out.finite = false;
   const Trip t = p.check(b.m, b.e, b.s, b.law, b.out, Vec2::Zero());
@@ -126,10 +141,10 @@ TEST(Protection, TheCommandWatchdogNeedsCanCommands) {
   b.config.protection.command_timeout_s = 0.01;  // 100 ticks
   b.s.watchdog_armed = true;
   b.s.command_silence_ticks = 101;
-  Protection<double> local = b.make();
+  MotorProtection local = b.make();
   EXPECT_FALSE(local.check(b.m, b.e, b.s, b.law, b.out, Vec2::Zero()).any());
   b.config.commands_over_can = true;
-  Protection<double> commanded = b.make();
+  MotorProtection commanded = b.make();
   EXPECT_EQ(commanded.check(b.m, b.e, b.s, b.law, b.out, Vec2::Zero()).first,
             FaultCode::command_timeout);
 }
@@ -137,12 +152,12 @@ TEST(Protection, TheCommandWatchdogNeedsCanCommands) {
 TEST(Protection, TheBudgetIsInCountsOfTheExecutionClock) {
   Bench b;
   b.config.protection.tick_budget_ns = 90'000;
-  Protection<double> p = b.make();
+  MotorProtection p = b.make();
   p.set_clock(25'000'000);  // 40 ns per count: 2250 counts
   EXPECT_FALSE(p.over_budget(2250).any());
   EXPECT_EQ(p.over_budget(2251).first, FaultCode::overrun);
   b.config.protection.tick_budget_ns = 0;  // not checked
-  Protection<double> unchecked = b.make();
+  MotorProtection unchecked = b.make();
   unchecked.set_clock(25'000'000);
   EXPECT_FALSE(unchecked.over_budget(UINT32_MAX).any());
 }
@@ -150,11 +165,11 @@ TEST(Protection, TheBudgetIsInCountsOfTheExecutionClock) {
 TEST(Protection, TheSensorChecksCanBeSwitchedOff) {
   Bench b;
   b.config.protection.check_encoder = false;
-  Protection<double> p = b.make();
+  MotorProtection p = b.make();
   b.m.encoder_delta_counts = 100000;  // an impossible jump
   EXPECT_FALSE(p.check(b.m, b.e, b.s, b.law, b.out, Vec2::Zero()).any());
   b.config.protection.check_encoder = true;
-  Protection<double> checked = b.make();
+  MotorProtection checked = b.make();
   EXPECT_EQ(checked.check(b.m, b.e, b.s, b.law, b.out, Vec2::Zero()).first, FaultCode::encoder);
 }
 

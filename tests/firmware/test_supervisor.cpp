@@ -48,7 +48,7 @@ struct Bench {
         coefficients(control::discretize_voltage_fed(test::paper_motor(), 1e-4)),
         laws(LawContext{test::paper_motor(), config, coefficients}),
         magnetizer(test::paper_motor(), coefficients, config),
-        supervisor(config, {&can, &gpio, telemetry}, &references, laws, magnetizer, true, true) {
+        supervisor(config, {&can, &gpio, telemetry}, &references, &laws, &magnetizer, true, true) {
     m.valid = true;
     e.valid = true;
   }

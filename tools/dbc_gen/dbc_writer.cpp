@@ -96,6 +96,15 @@ void write_attributes(Out out, uint8_t node_id) {
   }
 }
 
+// IEEE float signals (SIG_VALTYPE_ 1: single precision).
+void write_value_types(Out out, uint8_t node_id) {
+  for (const protocol::Message& m : protocol::kMessages) {
+    for (const protocol::Signal& s : m.signals) {
+      if (s.is_float) fmt::format_to(out, "SIG_VALTYPE_ {} {} : 1;\n", can_id(node_id, m), s.name);
+    }
+  }
+}
+
 void write_value_tables(Out out, uint8_t node_id) {
   for (const protocol::Message& m : protocol::kMessages) {
     for (const protocol::Signal& s : m.signals) {
@@ -117,6 +126,7 @@ std::string dbc_text(uint8_t node_id) {
   write_comments(out, node_id);
   write_attributes(out, node_id);
   write_value_tables(out, node_id);
+  write_value_types(out, node_id);
   return text;
 }
 

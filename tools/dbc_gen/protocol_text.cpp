@@ -27,6 +27,7 @@ double physical(const Signal& s, int64_t raw) {
 }
 
 std::string type_name(const Signal& s) {
+  if (s.is_float) return "float32";
   return fmt::format("{}int{}", s.is_signed ? "" : "u", s.length_bits);
 }
 

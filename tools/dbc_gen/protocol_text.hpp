@@ -26,11 +26,12 @@ double decimal_offset(const Signal& s);
 inline std::string offset_text(const Signal& s) {
   return plain_decimal(decimal_offset(s));
 }
+// A float signal's range is the float's: a DBC writes it as [0|0] (no range).
 inline std::string min_text(const Signal& s) {
-  return plain_decimal(physical(s, s.raw_min()));
+  return s.is_float ? "0" : plain_decimal(physical(s, s.raw_min()));
 }
 inline std::string max_text(const Signal& s) {
-  return plain_decimal(physical(s, s.raw_max()));
+  return s.is_float ? "0" : plain_decimal(physical(s, s.raw_max()));
 }
 
 /// "uint8", "int16", "uint4", ...
@@ -80,6 +81,10 @@ constexpr bool signal_is_writable(const Signal& s, int length_bytes) {
   if (!is_identifier(s.name) || !is_dbc_string(s.unit) || !is_dbc_string(s.comment)) return false;
   if (s.length_bits == 0 || s.start_bit + s.length_bits > 8 * length_bytes) return false;
   if (s.scale_num <= 0 || s.scale_den <= 0) return false;
+  if (s.is_float && (s.length_bits != 32 || s.is_signed || s.scale() != 1.0 || s.offset != 0.0f ||
+                     !s.values.empty())) {
+    return false;  // SIG_VALTYPE_ 1: a plain single-precision float
+  }
   for (const auto& v : s.values) {
     if (!is_dbc_string(v.name) || v.raw < s.raw_min() || v.raw > s.raw_max()) return false;
   }
