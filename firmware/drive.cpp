@@ -89,28 +89,26 @@ void Drive<T>::release_model() noexcept {
 
 template <typename T>
 void Drive<T>::service() noexcept {
-  switch (bank_.pending()) {
-    case ParameterBank::Request::none:
+  switch (bank_.stage()) {
+    case ParameterBank::Stage::access:
+      bank_.serve(hw_.store);
       return;
-    case ParameterBank::Request::apply:
+    case ParameterBank::Stage::apply:
+      // The tick let go of the model before it asked: it is the service loop's to rebuild.
       model_.reset();
       model_.emplace(bank_.staged(), config_, board_);
       model_ready_.store(true, std::memory_order_release);
-      bank_.complete_request(ParameterStatus::ok);
+      bank_.applied();
       return;
-    case ParameterBank::Request::save: {
-      const auto record = encode_motor_record(bank_.staged());
-      const bool saved = hw_.store != nullptr && hw_.store->save(record);
-      bank_.complete_request(saved ? ParameterStatus::ok : ParameterStatus::store_failed);
+    case ParameterBank::Stage::free:
+    case ParameterBank::Stage::answered:
       return;
-    }
   }
 }
 
 template <typename T>
 std::optional<control::MotorParameters> Drive<T>::motor() const noexcept {
-  if (!bank_.complete()) return std::nullopt;
-  return bank_.staged();
+  return bank_.record();
 }
 
 template <typename T>

@@ -39,7 +39,9 @@ Supervisor<T>::Supervisor(const DriveConfig& config, const SupervisorWiring& wir
           std::min(config.max_accel_rad_s2, config.stop_decel_rad_s2), config.sample_period_s)),
       stop_speed_rad_s_(T(config.stop_speed_rad_s)),
       stop_timeout_ticks_(duration_ticks(config.stop_timeout_s, config.sample_period_s)),
-      calibrated_(calibrated) {
+      calibrated_(calibrated),
+      record_complete_(laws != nullptr),
+      record_saved_(laws != nullptr) {
   select(config.controller);
   if (calibrated_) {
     machine_.go(rest_state(), TransitionReason::calibrated, 0);
@@ -56,6 +58,7 @@ void Supervisor<T>::attach(LawRegistry<T>* laws, const Magnetizer<T>* magnetizer
   magnetizer_ = magnetizer;
   if (laws_ == nullptr) return;
   select(controller_);
+  if (machine_.state() != DriveState::unconfigured) return;  // e.g. a fault came meanwhile
   if (machine_.go(DriveState::idle, TransitionReason::configured, k) && auto_enable_) {
     TickPlan<T> unused;
     enable(k, unused);

@@ -104,7 +104,10 @@ class Supervisor {
   }
   protocol::CommandResult access_parameter(const protocol::Command& c, uint64_t k,
                                            TickPlan<T>& p) noexcept;
-  void answer_parameter(uint8_t field, protocol::ParameterOp op, ParameterStatus status) noexcept;
+  /// The answers the service loop has ready; a write that completed a record starts the
+  /// change of model (idle -> unconfigured).
+  void answer_served_access(uint64_t k) noexcept;
+  void answer_parameter(const ParameterAnswer& a) noexcept;
   bool commands_over_can_, auto_enable_;
   int enable_input_line_;
   SupervisorWiring wiring_;
@@ -124,6 +127,7 @@ class Supervisor {
   T stop_speed_rad_s_;
   uint64_t stop_timeout_ticks_;
   bool calibrated_;
+  bool record_complete_, record_saved_;  ///< as the last parameter answer said
   bool enable_input_ = true;  ///< read at the start of the stage
   uint64_t magnetizing_start_tick_ = 0, last_command_tick_ = 0, stop_start_tick_ = 0;
 };

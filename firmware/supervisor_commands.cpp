@@ -13,11 +13,7 @@ inline constexpr int kMaxFramesPerTick = 4;
 template <typename T>
 void Supervisor<T>::receive_commands(uint64_t k, TickPlan<T>& p) noexcept {
   if (wiring_.can == nullptr) return;
-  if (wiring_.parameters != nullptr) {
-    if (const auto saved = wiring_.parameters->take_outcome()) {
-      answer_parameter(0, protocol::ParameterOp::save, *saved);
-    }
-  }
+  answer_served_access(k);
   hal::CanFrame frame;
   for (int n = 0; n < kMaxFramesPerTick && wiring_.can->try_receive(frame); ++n) {
     protocol::Decoded d = decoder_.decode(frame);
@@ -66,6 +62,10 @@ protocol::CommandResult Supervisor<T>::apply(const protocol::Command& c, uint64_
     }
     case CommandKind::enable:
       if (!enable_input_) return CommandResult::not_allowed;  // the board's interlock is open
+      // A parameter access in progress may change the model: not while it could run.
+      if (wiring_.parameters != nullptr && wiring_.parameters->busy()) {
+        return CommandResult::not_allowed;
+      }
       if (s == DriveState::idle) enable(k, p);
       return s == DriveState::idle || s == DriveState::magnetizing || s == DriveState::running
                  ? CommandResult::accepted
@@ -117,56 +117,49 @@ protocol::CommandResult Supervisor<T>::apply(const protocol::Command& c, uint64_
 }
 
 template <typename T>
-protocol::CommandResult Supervisor<T>::access_parameter(const protocol::Command& c, uint64_t k,
+protocol::CommandResult Supervisor<T>::access_parameter(const protocol::Command& c, uint64_t,
                                                         TickPlan<T>&) noexcept {
   using protocol::CommandResult;
-  using protocol::ParameterOp;
   ParameterBank* bank = wiring_.parameters;
   if (bank == nullptr) return CommandResult::not_allowed;
-  ParameterStatus status = ParameterStatus::ok;
-  switch (c.op) {
-    case ParameterOp::read: {
-      double value = 0.0;
-      status = bank->read(c.field, value);
-      break;
-    }
-    case ParameterOp::write: {
-      const DriveState s = machine_.state();
-      const bool at_rest = s == DriveState::idle || s == DriveState::unconfigured;
-      status = bank->write(c.field, double(c.value), at_rest);
-      // The model is rebuilt outside the tick: the drive is unconfigured until it is whole.
-      if (status == ParameterStatus::ok && bank->apply_wanted() && s == DriveState::idle) {
-        machine_.go(DriveState::unconfigured, TransitionReason::parameters_written, k);
-        status_.state = machine_.state();
-      }
-      break;
-    }
-    case ParameterOp::save:
-      status = bank->save();
-      if (status == ParameterStatus::ok) return CommandResult::accepted;  // answered when done
-      break;
+  const DriveState s = machine_.state();
+  ParameterAnswer refused;
+  refused.access = {c.op, c.field, c.value, s == DriveState::idle || s == DriveState::unconfigured};
+  refused.value = std::numeric_limits<float>::quiet_NaN();
+  refused.complete = record_complete_;
+  refused.saved = record_saved_;
+  // Checked and served outside the tick (Drive::service); answered when served.
+  if (c.op == protocol::ParameterOp::write && !refused.access.at_rest) {
+    refused.status = ParameterStatus::not_idle;
+  } else if (!bank->submit(refused.access)) {
+    refused.status = ParameterStatus::busy;
+  } else {
+    return CommandResult::accepted;
   }
-  answer_parameter(c.field, c.op, status);
-  switch (status) {
-    case ParameterStatus::ok: return CommandResult::accepted;
-    case ParameterStatus::not_idle:
-    case ParameterStatus::busy:
-    case ParameterStatus::not_set: return CommandResult::not_allowed;
-    default: return CommandResult::out_of_range;
+  answer_parameter(refused);
+  return CommandResult::not_allowed;
+}
+
+template <typename T>
+void Supervisor<T>::answer_served_access(uint64_t k) noexcept {
+  if (wiring_.parameters == nullptr) return;
+  const std::optional<ParameterAnswer> a = wiring_.parameters->take_answer();
+  if (!a) return;
+  record_complete_ = a->complete;
+  record_saved_ = a->saved;
+  answer_parameter(*a);
+  // The drive lets go of its model at the end of this tick; unconfigured until the new one.
+  if (a->apply && machine_.state() == DriveState::idle) {
+    machine_.go(DriveState::unconfigured, TransitionReason::parameters_written, k);
+    status_.state = machine_.state();
   }
 }
 
 template <typename T>
-void Supervisor<T>::answer_parameter(uint8_t field, protocol::ParameterOp op,
-                                     ParameterStatus status) noexcept {
-  const ParameterBank* bank = wiring_.parameters;
-  if (wiring_.can == nullptr || bank == nullptr) return;
-  double value = std::numeric_limits<double>::quiet_NaN();
-  // The value after the operation: the new one, or the unchanged one of a refused write.
-  const ParameterStatus read = bank->read(field, value);
-  if (read != ParameterStatus::ok) value = std::numeric_limits<double>::quiet_NaN();
-  wiring_.telemetry.parameter_value(*wiring_.can, field, op, static_cast<uint8_t>(status),
-                                    static_cast<float>(value), bank->complete(), bank->saved());
+void Supervisor<T>::answer_parameter(const ParameterAnswer& a) noexcept {
+  if (wiring_.can == nullptr) return;
+  wiring_.telemetry.parameter_value(*wiring_.can, a.access.field, a.access.op,
+                                    static_cast<uint8_t>(a.status), a.value, a.complete, a.saved);
 }
 
 // The class is instantiated in supervisor.cpp; these members are defined here.
@@ -178,8 +171,8 @@ void Supervisor<T>::answer_parameter(uint8_t field, protocol::ParameterOp op,
                                                         TickPlan<T>&) noexcept;            \
   template protocol::CommandResult Supervisor<T>::access_parameter(                         \
       const protocol::Command&, uint64_t, TickPlan<T>&) noexcept;                           \
-  template void Supervisor<T>::answer_parameter(uint8_t, protocol::ParameterOp,             \
-                                                ParameterStatus) noexcept;
+  template void Supervisor<T>::answer_served_access(uint64_t) noexcept;                     \
+  template void Supervisor<T>::answer_parameter(const ParameterAnswer&) noexcept;
 IMD_INSTANTIATE_COMMANDS(float)
 IMD_INSTANTIATE_COMMANDS(double)
 #undef IMD_INSTANTIATE_COMMANDS

@@ -11,8 +11,12 @@
 namespace imd::hal {
 
 class FlashPages {
+ protected:
+  // Never deleted through the interface (nothing is allocated): no virtual destructor, so no
+  // deleting destructor and no operator delete in the firmware's vtables.
+  ~FlashPages() = default;
+
  public:
-  virtual ~FlashPages() = default;
   virtual std::size_t page_bytes() const noexcept = 0;
   virtual std::size_t program_unit() const noexcept = 0;
   /// False if the medium failed (the page's content is then undefined).

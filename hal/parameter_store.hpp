@@ -12,8 +12,12 @@
 namespace imd::hal {
 
 class ParameterStore {
+ protected:
+  // Never deleted through the interface (nothing is allocated): no virtual destructor, so no
+  // deleting destructor and no operator delete in the firmware's vtables.
+  ~ParameterStore() = default;
+
  public:
-  virtual ~ParameterStore() = default;
   /// Copies the newest whole record into `out`; returns its length, 0 when there is none (or it
   /// does not fit in `out`).
   virtual std::size_t load(std::span<uint8_t> out) noexcept = 0;

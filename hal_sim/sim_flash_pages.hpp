@@ -5,27 +5,29 @@
 /// and every operation fails, as on a board whose supply has gone; a new store built over the
 /// same pages is the board after the next power-up. Programming ANDs the bits in, as flash
 /// does, and a unit may be programmed only once between erases (a second time is a failure).
+/// STM32G4's geometry: 2 KiB pages, 8-byte units. No heap (the processor-in-the-loop image
+/// has one).
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <bitset>
 #include <limits>
 #include <span>
-#include <vector>
 
 #include "hal/flash_pages.hpp"
 
-namespace imd::hal_sim {
+namespace imd::sim {
 
 class SimFlashPages final : public hal::FlashPages {
  public:
-  /// STM32G4's geometry by default: 2 KiB pages, 8-byte units.
-  explicit SimFlashPages(std::size_t page_bytes = 2048, std::size_t unit_bytes = 8)
-      : unit_(unit_bytes),
-        pages_{std::vector<uint8_t>(page_bytes, 0xFF), std::vector<uint8_t>(page_bytes, 0xFF)},
-        written_{std::vector<bool>(page_bytes / unit_bytes), std::vector<bool>(page_bytes / unit_bytes)} {}
+  static constexpr std::size_t kPageBytes = 2048, kUnitBytes = 8;
 
-  std::size_t page_bytes() const noexcept override { return pages_[0].size(); }
-  std::size_t program_unit() const noexcept override { return unit_; }
+  SimFlashPages() noexcept {
+    for (auto& page : pages_) page.fill(0xFF);
+  }
+
+  std::size_t page_bytes() const noexcept override { return kPageBytes; }
+  std::size_t program_unit() const noexcept override { return kUnitBytes; }
 
   bool erase(int page) noexcept override {
     if (!valid_page(page)) return false;
@@ -33,22 +35,22 @@ class SimFlashPages final : public hal::FlashPages {
       if (!spend()) return false;
       b = 0xFF;
     }
-    written_[page].assign(written_[page].size(), false);
+    written_[page].reset();
     return true;
   }
 
   bool program(int page, std::size_t offset, std::span<const uint8_t> bytes) noexcept override {
-    if (!valid_page(page) || offset % unit_ != 0 || bytes.size() % unit_ != 0 ||
+    if (!valid_page(page) || offset % kUnitBytes != 0 || bytes.size() % kUnitBytes != 0 ||
         offset + bytes.size() > page_bytes()) {
       return false;
     }
-    for (std::size_t u = 0; u < bytes.size() / unit_; ++u) {
-      if (written_[page][offset / unit_ + u]) return false;
+    for (std::size_t u = 0; u < bytes.size() / kUnitBytes; ++u) {
+      if (written_[page][offset / kUnitBytes + u]) return false;
     }
     for (std::size_t i = 0; i < bytes.size(); ++i) {
       if (!spend()) return false;
       pages_[page][offset + i] &= bytes[i];
-      written_[page][(offset + i) / unit_] = true;
+      written_[page][(offset + i) / kUnitBytes] = true;
     }
     return true;
   }
@@ -76,11 +78,10 @@ class SimFlashPages final : public hal::FlashPages {
     return true;
   }
 
-  std::size_t unit_;
-  std::array<std::vector<uint8_t>, 2> pages_;
-  std::array<std::vector<bool>, 2> written_;
+  std::array<std::array<uint8_t, kPageBytes>, 2> pages_;
+  std::array<std::bitset<kPageBytes / kUnitBytes>, 2> written_;
   std::size_t budget_ = std::numeric_limits<std::size_t>::max();
   std::size_t operations_ = 0;
 };
 
-}  // namespace imd::hal_sim
+}  // namespace imd::sim

@@ -4,9 +4,13 @@
 //   drive_hil SCENARIO.toml --can IFACE --node N
 //             [--gpio-chip NAME [--enable-line L] [--fault-line L] [--timing-line L]
 //              [--enable-active-low]]
-//             [--duration-s S] [--latency-report PATH] [--priority P] [--cpu C] [--set K=V]...
+//             [--parameters PATH] [--duration-s S] [--latency-report PATH] [--priority P]
+//             [--cpu C] [--set K=V]...
 //
-// The scenario gives the motor, the board and the drive's configuration. With a CAN interface
+// The scenario gives the motor, the board and the drive's configuration. With --parameters the
+// drive takes its motor parameters from that record file instead (as a board takes them from
+// its flash), and a save over CAN writes it; a missing or invalid file leaves the drive
+// unconfigured until a record is written over CAN. With a CAN interface
 // the drive takes its references and enable only from CAN commands (and the enable line); the
 // scenario's [[can_commands]] are not sent. `--can none` runs without a bus: the scenario's own
 // reference profile drives the run (for latency measurements on a machine without CAN).
@@ -20,12 +24,14 @@
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
 
+#include <array>
 #include <csignal>
 #include <cstdio>
 #include <fstream>
 #include <iostream>
 #include <memory>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -34,6 +40,8 @@
 #include "firmware/linux/hil_tick.hpp"
 #include "firmware/protocol/messages.hpp"
 #include "hal_sim/drive/scenario_config.hpp"
+#include "firmware/parameters/motor_record.hpp"
+#include "hal/linux/file_parameter_store.hpp"
 #include "hal/linux/gpiod_lines.hpp"
 #include "hal/linux/queued_can_bus.hpp"
 #include "hal/linux/realtime_timer.hpp"
@@ -57,6 +65,7 @@ struct Options {
   bool enable_active_low = false;
   std::optional<double> duration_s;
   std::string latency_report;
+  std::string parameters;
   int priority = 80;
   int cpu = -1;
   std::vector<std::string> overrides;
@@ -93,7 +102,7 @@ template <typename Stopped>
 std::string wait_for_stop(const sigset_t& signals, std::optional<double> duration_s,
                           Stopped stopped) {
   const uint64_t start_ns = imd::hal::monotonic_ns();
-  const timespec poll_interval{0, 50'000'000};  // 50 ms
+  const timespec poll_interval{0, 10'000'000};  // 10 ms
   while (true) {
     const int signal = ::sigtimedwait(&signals, nullptr, &poll_interval);
     if (signal == SIGINT) return "SIGINT";
@@ -132,9 +141,22 @@ int run(const Options& o, const imd::sim::Scenario& s, imd::hal::QueuedCanBus* c
   timing.cpu = o.cpu;
   hal::RealtimeTimer timer(timing);
   const sim::ScenarioReferences<T> references(s);
+  std::optional<hal::FileParameterStore> file_store;
+  if (!o.parameters.empty()) {
+    file_store.emplace(o.parameters);
+    std::array<uint8_t, firmware::kMotorRecordBytes> record{};
+    const std::size_t n = file_store->load(record);
+    if (n == 0) {
+      warnings.push_back(file_store->last_error() + ": the drive starts unconfigured");
+    } else if (!firmware::decode_motor_record(std::span<const uint8_t>(record).first(n))) {
+      warnings.push_back(o.parameters + ": not a valid motor record of this firmware: the drive "
+                         "starts unconfigured");
+    }
+  }
   sim::SimulatedDrive<T> simulated(board, s.motor, config,
                                    {s.ideal_sensors, s.inner_feedback, s.current_fed},
-                                   &references, timer, can, gpio);
+                                   &references, timer, can, gpio,
+                                   file_store ? &*file_store : nullptr);
   firmware::Drive<T>& drive = simulated.drive();
   firmware::HilTick<T> tick(board, drive, s.faults);
 
@@ -149,8 +171,12 @@ int run(const Options& o, const imd::sim::Scenario& s, imd::hal::QueuedCanBus* c
   if (!timer.running()) return fail(timer.warning(), kExitFailed);
   if (!timer.warning().empty()) warnings.push_back(timer.warning());
   for (const std::string& w : warnings) std::cerr << "drive_hil: warning: " << w << '\n';
-  const std::string reason =
-      wait_for_stop(signals, o.duration_s, [&tick] { return tick.plant_diverged(); });
+  // The main thread serves the drive's out-of-tick work (a new motor model, a save) while it
+  // waits.
+  const std::string reason = wait_for_stop(signals, o.duration_s, [&tick, &drive] {
+    drive.service();
+    return tick.plant_diverged();
+  });
   timer.stop();
   drive.shut_down(timer.tick_count());
   if (can != nullptr && !can->flush(100)) warnings.push_back("CAN frames left unsent at the stop");
@@ -209,6 +235,8 @@ int main(int argc, char** argv) {
   line("--timing-line", o.timing_line, "Timing output line: high while the tick computes");
   app.add_flag("--enable-active-low", o.enable_active_low,
                "The enable input is active when the line is low");
+  app.add_option("--parameters", o.parameters,
+                 "Motor parameter record file: loaded at start, written by a save over CAN");
   app.add_option("--duration-s", o.duration_s, "Stop after this many wall-clock seconds")
       ->check(CLI::Range(1e-3, 1e7));
   app.add_option("--latency-report", o.latency_report,

@@ -73,6 +73,7 @@ Summary run(const Scenario& s, const RunCallbacks& callbacks) {
       board.begin_period();
       board.fire_timer();
     });
+    drive.service();  // between ticks: where a board's main loop runs
     const firmware::TickRecord<T>& rec = drive.record();
     take_all_sent(board.can_side(), sent_frames);
     if (callbacks.can_frame) {

@@ -15,7 +15,7 @@
 namespace {
 
 using imd::hal::PagePairStore;
-using imd::hal_sim::SimFlashPages;
+using imd::sim::SimFlashPages;
 constexpr std::size_t kMax = 96;
 using Store = PagePairStore<kMax>;
 

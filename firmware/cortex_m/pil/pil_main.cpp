@@ -94,6 +94,7 @@ int run(const sim::EmbeddedScenario& s, const DriveConfig& drive_config, cm::Cms
       if (k > 0) timer.resume();
       wait_for_tick(timer);
     });
+    drive.service();  // the main loop's out-of-tick work, between ticks
     const TickRecord<float>& rec = drive.record();
     while (board.can_side().take_sent(frame)) ++frames_sent;  // the host side reads the bus
     if (rec.stages_timed) stage_totals.add(rec.stage_counts);

@@ -20,16 +20,6 @@ namespace imd::firmware::stm32g431 {
 
 namespace g4 = hal::cortex_m::stm32g4;
 
-/// Paper 000's motor (hal_sim/motors/seed000.toml; the firmware cannot read the file).
-inline constexpr control::MotorParameters kMotor{.Rs_Ohm = 14.0,
-                                                 .Ls_H = 0.4,
-                                                 .Lm_H = 0.377,
-                                                 .Rr_Ohm = 10.1,
-                                                 .Lr_H = 0.4128,
-                                                 .J_kgm2 = 0.01,
-                                                 .pole_pairs = 1,
-                                                 .friction_Nms = 0.0};
-
 // Power stage ratings (what the inverter board must provide, docs/porting.md).
 inline constexpr double kBusNominal_V = 311.0;  ///< rectified 220 V mains
 inline constexpr double kBusCapacitorRating_V = 450.0;

@@ -3,16 +3,23 @@
 /// reference, Drive<float> constructed once, then the tick: TIM1 runs the 10 kHz carrier, its
 /// TRGO2 starts the ADC before each peak, the ADC's end of sequence is the sample stage and
 /// PendSV the control stage (adc_tick.hpp). The drive takes its references and enable from CAN
-/// commands and the enable line. The main loop only moves queued CAN frames to the controller
-/// and sleeps.
+/// commands and the enable line. The motor parameters come from the record in the last two
+/// flash pages. The main loop moves queued CAN frames to the controller, serves the drive's
+/// out-of-tick work (a new motor model, a save) and sleeps.
 ///
 /// Safe state: TIM1 MOE off (every switch off). A processor fault, an unexpected interrupt or
 /// a start-up failure goes there, lights the fault line and stops; the reason is kept in
 /// g_fatal_fault / g_boot_failure for a debugger.
 #include <cstdint>
 
+#include <array>
+#include <span>
+
 #include "firmware/cortex_m/stm32g431/board_config.hpp"
 #include "firmware/drive.hpp"
+#include "firmware/parameters/motor_record.hpp"
+#include "hal/cortex_m/stm32g4/flash_pages.hpp"
+#include "hal/storage/page_pair_store.hpp"
 #include "hal/cortex_m/armv7m.hpp"
 #include "hal/cortex_m/fault_handler.hpp"
 
@@ -77,16 +84,24 @@ int main() {
   if (!can.ok()) halt(BootFailure::can);
   static g4::AdcEncoderSample sample(adc, encoder);
   static g4::AdcTick tick(kTick, adc, sample);
+  // The motor record from the parameter pages: the newest whole copy. Without one the drive
+  // stays unconfigured (its heartbeat says so) until a record is written over CAN.
+  static g4::FlashPagePair flash;
+  static hal::PagePairStore<firmware::kMotorRecordBytes> store(flash);
+  std::array<uint8_t, firmware::kMotorRecordBytes> record{};
+  const std::size_t record_bytes = store.load(record);
   // The drive follows its own CAN-commanded references (commands_over_can).
-  static firmware::Drive<float> drive(kMotor, drive_config(),
-                                      {pwm, encoder, adc, tick, &can, &gpio});
+  static firmware::Drive<float> drive(
+      firmware::decode_motor_record(std::span<const uint8_t>(record).first(record_bytes)),
+      drive_config(), {pwm, encoder, adc, tick, &can, &gpio, &store});
 
   // The carrier (and with it the ADC trigger) starts; the update event must be the peak.
   if (!pwm.start()) halt(BootFailure::pwm_phase);
   g4::bind_adc_tick_interrupts(tick);
   tick.start(drive);
   for (;;) {
-    can.pump();  // frames the last tick queued leave now, outside the tick
+    can.pump();       // frames the last tick queued leave now, outside the tick
+    drive.service();  // a parameter write's new model, a save: outside the tick
     cm::wait_for_interrupt();
   }
 }

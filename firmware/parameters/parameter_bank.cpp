@@ -1,0 +1,95 @@
+#include "firmware/parameters/parameter_bank.hpp"
+
+#include <limits>
+
+namespace imd::firmware {
+
+ParameterBank::ParameterBank(const std::optional<control::MotorParameters>& loaded) noexcept
+    : staged_(loaded.value_or(control::MotorParameters{0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0, 0.0})),
+      set_fields_(loaded ? kAllFields : 0u),
+      saved_(loaded.has_value()) {}
+
+bool ParameterBank::submit(const ParameterAccess& access) noexcept {
+  if (busy()) return false;
+  access_ = access;
+  stage_.store(Stage::access, std::memory_order_release);
+  return true;
+}
+
+std::optional<ParameterAnswer> ParameterBank::take_answer() noexcept {
+  if (stage() != Stage::answered) return std::nullopt;
+  const ParameterAnswer answer = answer_;
+  apply_wanted_ = answer.apply;
+  if (!apply_wanted_) stage_.store(Stage::free, std::memory_order_release);
+  return answer;
+}
+
+void ParameterBank::request_apply() noexcept {
+  apply_wanted_ = false;
+  stage_.store(Stage::apply, std::memory_order_release);
+}
+
+std::optional<control::MotorParameters> ParameterBank::record() const noexcept {
+  if (set_fields_ != kAllFields) return std::nullopt;
+  return staged_;
+}
+
+ParameterStatus ParameterBank::read(uint8_t field, double& value) const noexcept {
+  if (field >= kMotorFieldCount) return ParameterStatus::unknown_field;
+  if ((set_fields_ & (1u << field)) == 0) return ParameterStatus::not_set;
+  value = field_value(staged_, static_cast<MotorField>(field));
+  return ParameterStatus::ok;
+}
+
+ParameterStatus ParameterBank::write(uint8_t field, double value, bool at_rest,
+                                     bool& changed) noexcept {
+  changed = false;
+  if (field >= kMotorFieldCount) return ParameterStatus::unknown_field;
+  if (!at_rest) return ParameterStatus::not_idle;
+  const auto f = static_cast<MotorField>(field);
+  if (const ParameterStatus s = check_field(f, value); s != ParameterStatus::ok) return s;
+  control::MotorParameters candidate = staged_;
+  set_field(candidate, f, value);
+  const uint32_t fields = set_fields_ | (1u << field);
+  if (fields == kAllFields) {
+    if (const ParameterStatus s = check_record(candidate); s != ParameterStatus::ok) return s;
+  }
+  staged_ = candidate;
+  set_fields_ = fields;
+  saved_ = false;
+  changed = fields == kAllFields;
+  return ParameterStatus::ok;
+}
+
+void ParameterBank::serve(hal::ParameterStore* store) noexcept {
+  if (stage() != Stage::access) return;
+  ParameterAnswer a;
+  a.access = access_;
+  switch (access_.op) {
+    case protocol::ParameterOp::read:
+      break;
+    case protocol::ParameterOp::write:
+      a.status = write(access_.field, double(access_.value), access_.at_rest, a.apply);
+      break;
+    case protocol::ParameterOp::save:
+      if (set_fields_ != kAllFields) {
+        a.status = ParameterStatus::not_set;
+      } else if (store == nullptr || !store->save(encode_motor_record(staged_))) {
+        a.status = ParameterStatus::store_failed;
+      } else {
+        saved_ = true;
+      }
+      break;
+  }
+  double value = std::numeric_limits<double>::quiet_NaN();
+  const ParameterStatus read_status = read(access_.field, value);
+  if (access_.op == protocol::ParameterOp::read) a.status = read_status;
+  a.value = read_status == ParameterStatus::ok ? static_cast<float>(value)
+                                               : std::numeric_limits<float>::quiet_NaN();
+  a.complete = set_fields_ == kAllFields;
+  a.saved = saved_;
+  answer_ = a;
+  stage_.store(Stage::answered, std::memory_order_release);
+}
+
+}  // namespace imd::firmware
