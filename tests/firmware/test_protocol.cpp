@@ -1,7 +1,9 @@
 // The CAN protocol table, signal packing, the E2E CRC and the command decoder's rejections.
 #include <gtest/gtest.h>
 
+#include <bit>
 #include <cmath>
+#include <limits>
 #include <set>
 
 #include "firmware/protocol/commands.hpp"
@@ -87,6 +89,28 @@ TEST_F(Decoder, AcceptsAValidSequence) {
   EXPECT_EQ(b.counter, 1);
   EXPECT_EQ(decoder.last_counter(), 1);
   EXPECT_EQ(decoder.rejected_total(), 0u);
+}
+
+// The value travels as an IEEE single, exactly, NaN and infinities included: the drive judges
+// it and answers with its reason (tests/firmware/test_drive_parameters.cpp).
+TEST_F(Decoder, ParameterAccessCarriesOpFieldAndTheExactFloat) {
+  for (const float value : {0.377f, 1e-7f, -14.0f, std::numeric_limits<float>::quiet_NaN(),
+                            std::numeric_limits<float>::infinity()}) {
+    const Decoded d = decoder.decode(
+        encoder.encode({CommandKind::parameter_access, value, ParameterOp::write, 7}));
+    ASSERT_EQ(d.result, CommandResult::accepted) << value;
+    EXPECT_EQ(d.command.kind, CommandKind::parameter_access);
+    EXPECT_EQ(d.command.op, ParameterOp::write);
+    EXPECT_EQ(d.command.field, 7);
+    EXPECT_EQ(std::bit_cast<uint32_t>(d.command.value), std::bit_cast<uint32_t>(value));
+  }
+}
+
+TEST_F(Decoder, RejectsAParameterOpTheProtocolDoesNotDefine) {
+  hal::CanFrame f = encoder.encode({CommandKind::parameter_access, 1.0f, ParameterOp::save, 0});
+  f.data[1] = static_cast<uint8_t>((f.data[1] & 0x0F) | (kParameterOpCount << 4));
+  f.data[0] = e2e_crc(f.id, f.data, f.length);
+  EXPECT_EQ(decoder.decode(f).result, CommandResult::out_of_range);
 }
 
 TEST_F(Decoder, CounterWrapsAroundSixteen) {

@@ -48,6 +48,8 @@ bool value_in_range(const protocol::Command& c, const protocol::CommandLimits& l
     case CommandKind::set_telemetry_rate:
       return c.value >= float(protocol::kFastTelemetryMinHz) &&
              c.value <= float(protocol::kFastTelemetryMaxHz);
+    case CommandKind::parameter_access:  // any float: the drive judges it and answers why
+      return static_cast<int>(c.op) < protocol::kParameterOpCount;
     default:
       return c.value == 0.0f;
   }
@@ -116,7 +118,12 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
       FUZZ_CHECK(protocol::message_for(d.command.kind) == m->id);
       FUZZ_CHECK(frame.length == m->length);
       FUZZ_CHECK(frame.data[0] == protocol::e2e_crc(frame.id, frame.data, frame.length));
-      FUZZ_CHECK((frame.data[1] & 0xF0) == 0);
+      // Byte 1's high nibble is reserved (zero), except where parameter_access holds its op.
+      if (d.command.kind == CommandKind::parameter_access) {
+        FUZZ_CHECK((frame.data[1] >> 4) == static_cast<int>(d.command.op));
+      } else {
+        FUZZ_CHECK((frame.data[1] & 0xF0) == 0);
+      }
       FUZZ_CHECK(d.counter == (frame.data[1] & 0x0F));
       FUZZ_CHECK(decoder.last_counter() == d.counter);
       if (have_reference && d.command.kind != CommandKind::emergency_stop) {
