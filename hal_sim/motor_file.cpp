@@ -1,5 +1,7 @@
 #include "hal_sim/motor_file.hpp"
 
+#include <algorithm>
+
 #include <fmt/format.h>
 
 #include <cmath>
@@ -111,6 +113,39 @@ control::MotorParameters parse_motor_table(const toml::table& document, std::str
                                   problem->value, problem->rule));
   }
   return p;
+}
+
+namespace {
+/// A TOML float that reads back exactly: 17 significant digits, always with a '.' or an
+/// exponent (TOML reads "0" as an integer).
+std::string toml_float(double value) {
+  std::string text = fmt::format("{:.17g}", value);
+  if (text.find_first_of(".eEn") == std::string::npos) text += ".0";
+  return text;
+}
+}  // namespace
+
+std::string motor_file_text(const control::MotorParameters& m, std::string_view name,
+                            std::string_view comment) {
+  std::string text;
+  for (std::size_t begin = 0; begin < comment.size();) {
+    const std::size_t end = std::min(comment.find('\n', begin), comment.size());
+    text += fmt::format("# {}\n", comment.substr(begin, end - begin));
+    begin = end + 1;
+  }
+  // A TOML basic string: quotes and backslashes escaped, control characters left out.
+  std::string quoted;
+  for (const char c : name) {
+    if (c == '"' || c == '\\') quoted += '\\';
+    if (static_cast<unsigned char>(c) >= 0x20) quoted += c;
+  }
+  text += fmt::format("[motor]\nname = \"{}\"\n", quoted);
+  text += fmt::format("Rs_Ohm = {}\nLs_H = {}\nLm_H = {}\nRr_Ohm = {}\n", toml_float(m.Rs_Ohm),
+                      toml_float(m.Ls_H), toml_float(m.Lm_H), toml_float(m.Rr_Ohm));
+  text += fmt::format("Lr_H = {}\nJ_kgm2 = {}\npole_pairs = {}\nfriction_Nms = {}\n",
+                      toml_float(m.Lr_H), toml_float(m.J_kgm2), m.pole_pairs,
+                      toml_float(m.friction_Nms));
+  return text;
 }
 
 control::MotorParameters load_motor_file(const std::filesystem::path& path) {

@@ -8,6 +8,7 @@
 /// All eight keys are required; other keys in the table are free (names, ratings). Host only.
 #include <toml++/toml.h>
 #include <filesystem>
+#include <string>
 #include <string_view>
 
 #include "control/motor_parameters.hpp"
@@ -23,6 +24,12 @@ control::MotorParameters load_motor_file(const std::filesystem::path& path);
 /// messages.
 control::MotorParameters parse_motor_table(const toml::table& document, std::string_view source,
                                            std::string_view table = "motor");
+
+/// The text of a motor file that load_motor_file reads back exactly (every value to 17
+/// significant digits): a comment block (each line of `comment` gets "# "), then [motor] with
+/// `name` and the eight keys.
+std::string motor_file_text(const control::MotorParameters& motor, std::string_view name,
+                            std::string_view comment);
 
 /// Parses a TOML file, turning a syntax error into a ConfigError with file, line and column.
 toml::table parse_toml_file(const std::filesystem::path& path);

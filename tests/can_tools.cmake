@@ -2,6 +2,8 @@
 # Test names contain can_log, socketcan or monitor; all are in the unit tier.
 imd_add_test(test_can_log unit LIBRARIES imd_can_log SOURCES tools/test_can_log.cpp)
 imd_add_test(test_drive_monitor unit LIBRARIES imd_drive_monitor SOURCES tools/test_drive_monitor.cpp)
+imd_add_test(test_drive_monitor_parameters unit LIBRARIES imd_drive_monitor
+             SOURCES tools/test_drive_monitor_parameters.cpp)
 
 # drive_monitor: exit code 2 and a clear message on bad input (the interface is checked on a
 # machine that may have no CAN at all: either message is clear), decoding of a recorded log.
@@ -53,6 +55,17 @@ if(TARGET drive_monitor)
                    send --can vcan9 --node 1 reboot)
   imd_monitor_test(drive_monitor_send_missing_value 2 "set-speed needs a value \\(RAD_S\\)"
                    send --can vcan9 --node 1 set-speed)
+  imd_monitor_test(drive_monitor_parameters_unknown_key 2
+                   "'Rx_Ohm' is not a motor parameter \\(known: Rs_Ohm, Ls_H"
+                   parameters --can vcan9 --node 1 --set Rx_Ohm=1)
+  imd_monitor_test(drive_monitor_parameters_not_a_number 2 "Rr_Ohm: 'hot' is not a finite number"
+                   parameters --can vcan9 --node 1 --set Rr_Ohm=hot)
+  imd_monitor_test(drive_monitor_parameters_bad_motor_file 2
+                   "bad_negative_Rs.toml: motor.Rs_Ohm = -1: must be > 0"
+                   parameters --can vcan9 --node 1
+                   --motor-file ${CMAKE_CURRENT_SOURCE_DIR}/data/motors/bad_negative_Rs.toml)
+  imd_monitor_test(drive_monitor_parameters_bad_interface 2 "${NO_CAN_IFACE}"
+                   parameters --can vcan9 --node 1)
   imd_monitor_test(drive_monitor_send_bad_counter 2 "--counter: Value 16 not in range 0 to 15"
                    send --can vcan9 --node 1 --counter 16 enable)
 endif()

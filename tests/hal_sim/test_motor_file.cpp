@@ -144,3 +144,30 @@ TEST(MotorFile, ErrorsFromAFileNameTheFile) {
 
 }  // namespace
 }  // namespace imd::sim
+
+namespace imd::sim {
+namespace {
+
+// A written motor file reads back bit for bit, whatever the values' magnitudes.
+TEST(MotorFileText, ReadsBackExactly) {
+  for (const auto& motor : test::test_motors()) {
+    control::MotorParameters m = motor.parameters;
+    m.friction_Nms = 0.0;  // "0" would be an integer in TOML: written as 0.0
+    const std::string text = motor_file_text(m, "a \"quoted\" name", "line one\nline two");
+    EXPECT_EQ(text.rfind("# line one\n# line two\n[motor]\n", 0), 0u) << text;
+    const toml::table doc = toml::parse(text);
+    const control::MotorParameters back = parse_motor_table(doc, "written");
+    EXPECT_EQ(back.Rs_Ohm, m.Rs_Ohm);
+    EXPECT_EQ(back.Ls_H, m.Ls_H);
+    EXPECT_EQ(back.Lm_H, m.Lm_H);
+    EXPECT_EQ(back.Rr_Ohm, m.Rr_Ohm);
+    EXPECT_EQ(back.Lr_H, m.Lr_H);
+    EXPECT_EQ(back.J_kgm2, m.J_kgm2);
+    EXPECT_EQ(back.pole_pairs, m.pole_pairs);
+    EXPECT_EQ(back.friction_Nms, 0.0);
+    EXPECT_EQ(doc["motor"]["name"].value<std::string>(), "a \"quoted\" name");
+  }
+}
+
+}  // namespace
+}  // namespace imd::sim

@@ -84,6 +84,26 @@ sleep 0.5  # the final heartbeat reaches the monitor
 kill -INT $WATCH; wait $WATCH
 for f in telemetry.csv hil.log latency.json commands.log watch.log; do emit $f /tmp/$f; done
 
+say "motor parameters over CAN: unconfigured start, refused writes, a whole motor file, a save"
+rm -f /tmp/motor.rec
+drive_hil $S/hil.toml $NODE --parameters /tmp/motor.rec --duration-s 100 > /tmp/param_hil.log 2>&1 &
+HIL=$!
+P="drive_monitor parameters $NODE --wait-s 5"
+{
+  sleep 1
+  echo "step read"; $P; echo "exit $?"
+  echo "step negative"; $P --set Rs_Ohm=-1; echo "exit $?"
+  echo "step motor file"
+  $P --motor-file /hil/hal_sim/motors/seed000.toml --save --motor-out /tmp/motor_out.toml
+  echo "exit $?"
+  echo "step no leakage"; $P --set Lm_H=0.5; echo "exit $?"
+} > /tmp/parameters.log 2>&1
+kill -TERM $HIL; wait $HIL
+# The next power-up starts from the saved record: calibrated, then idle.
+drive_hil $S/hil.toml $NODE --parameters /tmp/motor.rec --duration-s 3 > /tmp/param_hil2.log 2>&1
+echo "drive_hil exit $?" >> /tmp/param_hil2.log
+for f in parameters.log param_hil.log param_hil2.log motor_out.toml; do emit $f /tmp/$f; done
+
 if [ "$GPIO" = 1 ]; then
   say "injected overvoltage at 0.3 s simulated"
   drive_hil $S/hil_fault.toml $NODE $RT --gpio-chip gpiochip0 --fault-line 5 --duration-s 100 \

@@ -7,7 +7,10 @@ usage: hil_test.py --arch x86_64|aarch64 --bin-dir DIR --source-dir DIR --cache 
 
 On both machines, over SocketCAN on vcan0: the drive calibrates and idles, is enabled and runs,
 follows a speed step to 30 rad/s, trips the command watchdog when the commands stop, and returns
-to idle on clear_faults; drive_hil stops cleanly on SIGTERM. On aarch64 (virt, PL061 GPIO) also:
+to idle on clear_faults; drive_hil stops cleanly on SIGTERM. With a parameter record file that
+does not exist yet, the drive starts without parameters; drive_monitor parameters has a
+negative resistance and a coupling without leakage refused with their reasons, writes a whole
+motor file, saves it, and exports it; the next start loads the saved record and idles. On aarch64 (virt, PL061 GPIO) also:
 wrong chip and line give clear errors, an inactive enable input refuses enable, the timing line
 pulses once per tick (seen by QEMU at the pin), and the fault line rises on the watchdog fault
 and on an injected overvoltage. Exit code 0 when every check passes.
@@ -115,6 +118,38 @@ def check_main_run(out, c):
     return report
 
 
+def check_parameters(out, c):
+    """drive_hil --parameters FILE and drive_monitor parameters over vcan0."""
+    log = (out / "parameters.log").read_text()
+    steps = {}
+    for block in log.split("step ")[1:]:
+        name, _, body = block.partition("\n")
+        steps[name] = body
+    first = steps.get("read", "")
+    c.check("record: incomplete" in first and "Rs_Ohm = (none)" in first and "exit 0" in first,
+            "without a record file the drive has no parameters",
+            first.strip().splitlines()[-2] if first.strip() else "no output")
+    negative = steps.get("negative", "")
+    c.check("write Rs_Ohm = -1: not_positive" in negative and "exit 3" in negative,
+            "a negative resistance is refused with its reason")
+    whole = steps.get("motor file", "")
+    c.check(whole.count(": ok") == 9 and "record: complete, saved" in whole and "exit 0" in whole,
+            "a whole motor file is written, applied and saved", f"{whole.count(': ok')} ok")
+    leak = steps.get("no leakage", "")
+    c.check("write Lm_H = 0.5: no_leakage" in leak and "Lm_H = 0.377" in leak and
+            "exit 3" in leak, "Lm^2 >= Ls Lr is refused and changes nothing")
+    exported = (out / "motor_out.toml").read_text()
+    c.check("Rs_Ohm = 14.0" in exported and "pole_pairs = 1" in exported,
+            "the record read back is written as a motor file")
+    first_run = (out / "param_hil.log").read_text()
+    c.check("/tmp/motor.rec: No such file or directory: the drive starts unconfigured"
+            in first_run, "drive_hil says why it starts without parameters")
+    restart = (out / "param_hil2.log").read_text()
+    c.check("drive idle" in restart and "drive_hil exit 0" in restart,
+            "the next start loads the saved record and idles",
+            "; ".join(restart.strip().splitlines()[-2:]))
+
+
 def check_gpio(out, trace, ticks, c):
     errors = (out / "gpio_errors.log").read_text()
     c.check("gpiochip7: no such GPIO chip" in errors, "a wrong chip is named in the error")
@@ -183,6 +218,7 @@ def main():
     c = Checks()
     out = args.work / "out"
     report = check_main_run(out, c)
+    check_parameters(out, c)
     if gpio:
         check_gpio(out, trace, report["ticks"], c)
     print(f"hil_test: {args.arch}: {'all checks passed' if c.failed == 0 else f'{c.failed} failed'}")

@@ -5,6 +5,8 @@
 //                       [--duration-s S]
 //   drive_monitor send --can IFACE --node N COMMAND [VALUE] [--counter C] [--wait-heartbeat-s S]
 //                      [--wait-ack-s S] [--repeat-hz F --for-s S]
+//   drive_monitor parameters --can IFACE --node N [--set KEY=VALUE]... [--motor-file PATH]
+//                            [--save] [--motor-out PATH] [--wait-s S]
 //
 // watch decodes node N's frames (default 1); the CSV's time_s is the log's timestamp, or with
 // --can the seconds since watch started. send learns the alive counter from the heartbeat.
@@ -20,6 +22,10 @@
 // be written, 2 bad input (command line, interface, log file), 3 a command frame rejected,
 // 4 no heartbeat or no acknowledgement (with --repeat-hz: none rejected, but some frame not
 // sent or unanswered).
+//
+// parameters writes the given fields (each answered after the drive has checked it: a refusal
+// prints its reason and the exit code is 3), saves the record if asked, then reads every field
+// back and prints it; --motor-out writes what it read as a motor file.
 #include <poll.h>
 #include <unistd.h>
 #include <CLI/CLI.hpp>
@@ -38,82 +44,20 @@
 #include "firmware/protection/protection_config.hpp"
 #include "hal/linux/socketcan_bus.hpp"
 #include "tools/can_log/candump_log.hpp"
+#include "tools/drive_monitor/cli_io.hpp"
 #include "tools/drive_monitor/monitor.hpp"
+#include "tools/drive_monitor/parameters_cli.hpp"
 #include "tools/drive_monitor/repeat_send.hpp"
 #include "tools/drive_monitor/send_command.hpp"
 #include "tools/drive_monitor/status_table.hpp"
 
 namespace {
 
-using Clock = std::chrono::steady_clock;
 using imd::monitor::DriveMonitor;
 using imd::monitor::TelemetryRow;
+using namespace imd::monitor::cli;
 
-constexpr int kExitOutputError = 1;
-constexpr int kExitBadInput = 2;
-constexpr int kExitRejected = 3;
-constexpr int kExitNoAnswer = 4;
 constexpr auto kRefreshPeriod = std::chrono::milliseconds(200);
-
-volatile std::sig_atomic_t g_stop = 0;
-extern "C" void on_signal(int) {
-  g_stop = 1;
-}
-
-/// The signal mask wait_readable's ppoll waits with; nullptr: the present one.
-const sigset_t* g_wait_mask = nullptr;
-
-/// SIGINT and SIGTERM set g_stop. While an object lives they are blocked except inside
-/// wait_readable, whose ppoll unblocks them atomically: a signal that lands between a check of
-/// g_stop and the wait still ends the wait at once, not at its timeout (1/F s can be minutes at
-/// a low --repeat-hz).
-class StopSignals {
- public:
-  StopSignals() {
-    struct sigaction action {};
-    action.sa_handler = on_signal;
-    sigemptyset(&action.sa_mask);
-    ::sigaction(SIGINT, &action, nullptr);
-    ::sigaction(SIGTERM, &action, nullptr);
-    sigset_t stop;
-    sigemptyset(&stop);
-    sigaddset(&stop, SIGINT);
-    sigaddset(&stop, SIGTERM);
-    ::sigprocmask(SIG_BLOCK, &stop, &previous_);
-    g_wait_mask = &previous_;
-  }
-  ~StopSignals() {
-    g_wait_mask = nullptr;
-    ::sigprocmask(SIG_SETMASK, &previous_, nullptr);
-  }
-  StopSignals(const StopSignals&) = delete;
-  StopSignals& operator=(const StopSignals&) = delete;
-
- private:
-  sigset_t previous_{};
-};
-
-std::string seconds_text(double seconds) {
-  std::ostringstream text;
-  text << seconds;
-  return text.str();
-}
-
-int fail(const std::string& message, int code = kExitBadInput) {
-  std::cerr << "drive_monitor: " << message << '\n';
-  return code;
-}
-
-/// A duration in (0, 1e7] s; CLI11's PositiveNumber lets NaN through.
-const CLI::Validator kSeconds(
-    [](std::string& text) -> std::string {
-      char* end = nullptr;
-      const double value = std::strtod(text.c_str(), &end);
-      if (end == text.c_str() || *end != '\0') return "must be a number, got " + text;
-      if (!(value > 0.0 && value <= 1e7)) return "must be a time in (0, 1e7] s, got " + text;
-      return {};
-    },
-    "SECONDS");
 
 /// A --repeat-hz rate in (0, kMaxRepeatRate_Hz].
 const CLI::Validator kRepeatRate(
@@ -177,23 +121,6 @@ class CsvOutput {
   std::ostream* stream_ = nullptr;
 };
 
-/// Waits until the socket has data or `deadline` passes (or a signal arrives). ppoll rather
-/// than poll for its nanosecond timeout (poll's milliseconds would make a wait up to a whole
-/// period late at 1000 Hz) and its atomic signal mask (StopSignals).
-void wait_readable(const imd::hal::SocketCanBus& bus, Clock::time_point deadline) {
-  const int64_t left_ns = std::max<int64_t>(
-      0, std::chrono::duration_cast<std::chrono::nanoseconds>(deadline - Clock::now()).count());
-  const timespec timeout{static_cast<time_t>(left_ns / 1'000'000'000),
-                         static_cast<long>(left_ns % 1'000'000'000)};
-  pollfd fd{bus.native_handle(), POLLIN, 0};
-  ::ppoll(&fd, 1, &timeout, g_wait_mask);
-}
-
-/// The interface is gone or down: waiting for it to come back is not this tool's job.
-bool interface_lost(const imd::hal::SocketCanBus& bus) {
-  return bus.last_errno() == ENODEV || bus.last_errno() == ENETDOWN;
-}
-
 imd::monitor::BusInfo bus_info(const imd::hal::SocketCanBus& bus) {
   const imd::hal::CanErrorState& e = bus.errors();
   return {e.error_frames, e.bus_off_events, e.bus_off,
@@ -239,8 +166,7 @@ int watch_live(const WatchOptions& o) {
   if (!bus) return fail(error);
   CsvOutput csv;
   if (!csv.open(o.csv, error)) return fail(error);
-  std::signal(SIGINT, on_signal);
-  std::signal(SIGTERM, on_signal);
+  set_stop_on_signals();
   const bool live_table = o.table || (!o.no_table && ::isatty(STDOUT_FILENO) == 1);
   if (live_table) std::cout << "\x1b[2J";
   DriveMonitor monitor(static_cast<uint8_t>(o.node));
@@ -275,22 +201,6 @@ int watch_live(const WatchOptions& o) {
   }
   if (!csv.good()) return fail(o.csv + ": write error", kExitOutputError);
   return 0;
-}
-
-/// Receives until `accept(frame)` returns true or `wait_s` passes.
-template <typename Accept>
-bool receive_until(imd::hal::SocketCanBus& bus, double wait_s, Accept accept) {
-  const Clock::time_point deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(
-                                                        std::chrono::duration<double>(wait_s));
-  imd::hal::CanFrame frame;
-  while (g_stop == 0) {
-    while (bus.try_receive(frame)) {
-      if (accept(frame)) return true;
-    }
-    if (Clock::now() >= deadline) return false;
-    wait_readable(bus, deadline);
-  }
-  return false;
 }
 
 /// send --repeat-hz: the frames go out on CommandRepeater's schedule; between them the loop
@@ -435,6 +345,9 @@ int main(int argc, char** argv) {
   repeat_option->needs(for_option);
   for_option->needs(repeat_option);
 
+  ParametersOptions p;
+  CLI::App* parameters = add_parameters_command(app, p);
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& error) {
@@ -445,6 +358,7 @@ int main(int argc, char** argv) {
     if (w.can.empty() && w.log.empty()) return fail("watch: give --can IFACE or --log FILE");
     return w.log.empty() ? watch_live(w) : watch_log(w);
   }
+  if (parameters->parsed()) return run_parameters(p);
   if (value_option->count() > 0) s.value = value;
   if (repeat_option->count() > 0) {
     s.repeat = imd::monitor::RepeatPlan{repeat_Hz, for_s, s.wait_ack_s};

@@ -1,0 +1,167 @@
+#include "tools/drive_monitor/parameters_cli.hpp"
+
+#include <fmt/format.h>
+
+#include <cmath>
+#include <fstream>
+#include <iostream>
+#include <optional>
+#include <thread>
+
+#include "firmware/protocol/commands.hpp"
+#include "hal_sim/config_error.hpp"
+#include "hal_sim/motor_file.hpp"
+#include "tools/drive_monitor/cli_io.hpp"
+#include "tools/drive_monitor/parameter_access.hpp"
+#include "tools/drive_monitor/send_command.hpp"
+
+namespace imd::monitor::cli {
+namespace {
+
+namespace protocol = firmware::protocol;
+using firmware::ParameterStatus;
+using protocol::ParameterOp;
+
+/// One conversation with the drive: each access waits for its answer, and a busy drive (still
+/// applying the last write) is asked again until the wait runs out.
+class Session {
+ public:
+  Session(hal::SocketCanBus& bus, uint8_t node, uint8_t counter, double wait_s)
+      : bus_(bus), node_(node), encoder_(node, counter), wait_s_(wait_s) {}
+
+  std::optional<ParameterReply> access(ParameterOp op, uint8_t field, float value = 0.0f) {
+    const auto deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(
+                                             std::chrono::duration<double>(wait_s_));
+    while (g_stop == 0) {
+      if (!bus_.try_send(encoder_.encode(parameter_command(op, field, value)))) return {};
+      std::optional<ParameterReply> reply;
+      receive_until(bus_, wait_s_, [&](const hal::CanFrame& f) {
+        reply = decode_parameter_value(f, node_);
+        return reply && reply->op == op && (op == ParameterOp::save || reply->field == field);
+      });
+      if (!reply || reply->status != ParameterStatus::busy || Clock::now() >= deadline) {
+        return reply;
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+    return {};
+  }
+
+ private:
+  hal::SocketCanBus& bus_;
+  uint8_t node_;
+  protocol::CommandEncoder encoder_;
+  double wait_s_;
+};
+
+/// The shortest text that reads back as the same float.
+std::string fmt_float(float value) {
+  return fmt::format("{}", value);
+}
+
+std::string value_text(float value) {
+  return std::isnan(value) ? "(none)" : fmt_float(value);
+}
+
+}  // namespace
+
+CLI::App* add_parameters_command(CLI::App& app, ParametersOptions& o) {
+  CLI::App* c = app.add_subcommand(
+      "parameters", "Read the drive's motor parameters; write, save, export them");
+  c->add_option("--can", o.can, "CAN interface (SocketCAN), e.g. can0")->required();
+  c->add_option("--node", o.node, "Node id of the drive")
+      ->check(CLI::Range(0, protocol::kMaxNodeId))
+      ->required();
+  c->add_option("--set", o.sets, "Write a field, KEY=VALUE (repeatable; keys: " +
+                                     field_names() + "); only while the drive is idle");
+  c->add_option("--motor-file", o.motor_file, "Write every field of this motor file");
+  c->add_flag("--save", o.save, "Save the record to the drive's storage (after any writes)");
+  c->add_option("--motor-out", o.motor_out, "Write what the drive holds as a motor file");
+  c->add_option("--wait-s", o.wait_s, "How long to wait for each answer")
+      ->check(kSeconds)
+      ->capture_default_str();
+  return c;
+}
+
+int run_parameters(const ParametersOptions& o) {
+  std::vector<Assignment> writes;
+  for (const std::string& text : o.sets) {
+    std::string error;
+    const auto a = parse_assignment(text, error);
+    if (!a) return fail("parameters: " + error);
+    writes.push_back(*a);
+  }
+  if (!o.motor_file.empty()) {
+    try {
+      const control::MotorParameters m = sim::load_motor_file(o.motor_file);
+      for (int i = 0; i < firmware::kMotorFieldCount; ++i) {
+        const auto f = static_cast<firmware::MotorField>(i);
+        writes.push_back({uint8_t(i), float(firmware::field_value(m, f))});
+      }
+    } catch (const sim::ConfigError& error) {
+      return fail(error.what());
+    }
+  }
+  std::string error;
+  const auto bus = hal::SocketCanBus::open(o.can, error);
+  if (!bus) return fail(error);
+  const auto node = static_cast<uint8_t>(o.node);
+  const StopSignals stop_signals;
+  std::optional<uint8_t> last;
+  receive_until(*bus, o.wait_heartbeat_s, [&](const hal::CanFrame& f) {
+    last = heartbeat_command_counter(f, node);
+    return last.has_value();
+  });
+  if (!last) {
+    return fail("no heartbeat from node " + std::to_string(o.node) + " on " + o.can, kExitNoAnswer);
+  }
+  Session session(*bus, node, static_cast<uint8_t>((*last + 1) & 0x0F), o.wait_s);
+
+  int status = 0;
+  // A new motor's inductances may pass through a record without leakage when written one at a
+  // time (Lm up before Ls and Lr): a write refused for that is tried again after the others.
+  for (int pass = 0; pass < 3 && !writes.empty(); ++pass) {
+    std::vector<Assignment> retry;
+    for (const Assignment& w : writes) {
+      const auto reply = session.access(ParameterOp::write, w.field, w.value);
+      if (!reply) return fail("write " + field_name(w.field) + ": no answer", kExitNoAnswer);
+      if (reply->status == ParameterStatus::no_leakage && pass < 2) {
+        retry.push_back(w);
+        continue;
+      }
+      std::cout << "write " << field_name(w.field) << " = " << fmt_float(w.value) << ": "
+                << status_name(reply->status) << '\n';
+      if (reply->status != ParameterStatus::ok) status = kExitRejected;
+    }
+    writes = retry;
+  }
+  if (o.save) {
+    const auto reply = session.access(ParameterOp::save, 0);
+    if (!reply) return fail("save: no answer", kExitNoAnswer);
+    std::cout << "save: " << status_name(reply->status) << '\n';
+    if (reply->status != ParameterStatus::ok) status = kExitRejected;
+  }
+  control::MotorParameters read;
+  bool complete = true, saved = false;
+  for (int i = 0; i < firmware::kMotorFieldCount; ++i) {
+    const auto reply = session.access(ParameterOp::read, uint8_t(i));
+    if (!reply) return fail("read " + field_name(uint8_t(i)) + ": no answer", kExitNoAnswer);
+    std::cout << field_name(uint8_t(i)) << " = " << value_text(reply->value) << '\n';
+    if (reply->status != ParameterStatus::ok) complete = false;
+    firmware::set_field(read, static_cast<firmware::MotorField>(i), double(reply->value));
+    saved = reply->saved;
+  }
+  std::cout << "record: " << (complete ? "complete" : "incomplete") << ", "
+            << (saved ? "saved" : "not saved") << '\n';
+  if (!o.motor_out.empty()) {
+    if (!complete) return fail("--motor-out: the drive holds no complete record", kExitRejected);
+    std::ofstream file(o.motor_out, std::ios::trunc);
+    file << sim::motor_file_text(read, "node " + std::to_string(o.node) + " on " + o.can,
+                                 "Motor parameters read from the drive (drive_monitor parameters).\n"
+                                 "Values are single precision, as the CAN message carries them.");
+    if (!file.flush()) return fail(o.motor_out + ": cannot write", kExitOutputError);
+  }
+  return status;
+}
+
+}  // namespace imd::monitor::cli
