@@ -43,7 +43,7 @@ struct MotorModel {
         svpwm(board.pwm, m, config.sample_period_s,
               {config.compensate_dead_time, config.dead_time_s, config.sample_period_s,
                control::derive_voltage_fed(m).sigma_H}),
-        checks(m, config, board.encoder_counts_per_rev, board.adc_A_per_code) {}
+        checks(m, coefficients, config, board.encoder_counts_per_rev, board.adc_A_per_code) {}
   MotorModel(const MotorModel&) = delete;
   MotorModel& operator=(const MotorModel&) = delete;
 

@@ -25,9 +25,10 @@ bool finite(const control::Vec2<T>& v) noexcept {
 /// observer the drive runs (construction only).
 template <typename T>
 typename EncoderCheck<T>::Config encoder_config(const control::MotorParameters& motor,
+                                                const control::VoltageFedCoefficients& c,
                                                 const DriveConfig& config, double counts_per_rev) {
   const control::QuantizationErrorBounds q = control::encoder_quantization_bounds(
-      control::discretize_voltage_fed(motor, config.sample_period_s),
+      c,
       config.encoder_observer_bandwidth_rad_s, 2.0 * std::numbers::pi / counts_per_rev);
   return {counts_per_rev,
           config.sample_period_s,
@@ -43,11 +44,12 @@ typename EncoderCheck<T>::Config encoder_config(const control::MotorParameters& 
 }  // namespace
 
 template <typename T>
-MotorChecks<T>::MotorChecks(const control::MotorParameters& motor, const DriveConfig& config,
+MotorChecks<T>::MotorChecks(const control::MotorParameters& motor,
+                            const control::VoltageFedCoefficients& c, const DriveConfig& config,
                             double counts_per_rev, double adc_A_per_code) noexcept
     : pole_pairs(T(motor.pole_pairs)),
       torque_per_AWb(T(control::kClarkeTorqueFactor * motor.pole_pairs * motor.Lm_H / motor.Lr_H)),
-      encoder(encoder_config<T>(motor, config, counts_per_rev)),
+      encoder(encoder_config<T>(motor, c, config, counts_per_rev)),
       adc_stuck(config.protection.adc_stuck_ticks, config.sample_period_s,
                 control::derive_voltage_fed(motor).sigma_H, adc_A_per_code) {}
 

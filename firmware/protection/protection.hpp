@@ -15,6 +15,7 @@
 #include <cstdint>
 
 #include "control/motor_parameters.hpp"
+#include "control/voltage_fed_model.hpp"
 #include "firmware/drive_config.hpp"
 #include "firmware/laws/control_law.hpp"
 #include "firmware/protection/adc_stuck_check.hpp"
@@ -43,9 +44,10 @@ struct SupervisedState {
 /// the encoder check, which needs the motor's motion model, is skipped.
 template <typename T>
 struct MotorChecks {
-  /// `counts_per_rev`, `adc_A_per_code`: the board's encoder and ADC.
-  MotorChecks(const control::MotorParameters& motor, const DriveConfig& config,
-              double counts_per_rev, double adc_A_per_code) noexcept;
+  /// `c`: the motor's exact model at the sample period; `counts_per_rev`, `adc_A_per_code`:
+  /// the board's encoder and ADC.
+  MotorChecks(const control::MotorParameters& motor, const control::VoltageFedCoefficients& c,
+              const DriveConfig& config, double counts_per_rev, double adc_A_per_code) noexcept;
   void reset() noexcept {
     encoder.reset();
     adc_stuck.reset();

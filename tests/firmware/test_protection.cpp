@@ -49,7 +49,10 @@ struct Bench {
   }
   MotorProtection make() const {
     return {Protection<double>(config),
-            MotorChecks<double>(test::paper_motor(), config, 8192.0, 10.0 / 2048)};
+            MotorChecks<double>(test::paper_motor(),
+                                control::discretize_voltage_fed(test::paper_motor(),
+                                                                config.sample_period_s),
+                                config, 8192.0, 10.0 / 2048)};
   }
 };
 
