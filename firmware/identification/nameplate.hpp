@@ -1,0 +1,63 @@
+#pragma once
+/// What a commissioning run starts from: the motor's nameplate, and the test levels, gains and
+/// times of the standstill identification derived from it and from the board by the rules of
+/// docs/identification.md. Construction only (double precision).
+#include <cmath>
+#include <numbers>
+
+namespace imd::firmware {
+
+struct Nameplate {
+  double rated_voltage_V = 0.0;     ///< line-to-line, RMS
+  double rated_current_A = 0.0;     ///< RMS
+  double rated_frequency_Hz = 0.0;  ///< stator frequency at rated speed
+  int pole_pairs = 0;
+};
+
+/// The standstill test's parameters (all currents are alpha-axis peaks).
+struct IdentificationPlan {
+  double period_s = 1e-4;
+  double i_low_A = 0.0, i_high_A = 0.0;  ///< the two DC levels
+  double sigma_Ls_guess_H = 0.0;  ///< the transient inductance expected from the nameplate
+  double kp_Ohm = 0.0, ki_Ohm_per_s = 0.0;  ///< the current loop's PI
+  double v_limit_V = 0.0;                   ///< the loop's output limit (linear SVPWM range)
+  double hf_voltage_V = 0.0;                ///< square-wave amplitude of the sigma Ls step
+  int hf_half_period_ticks = 2;
+  int hf_ticks = 2000;          ///< length of the square-wave injection
+  int window_ticks = 100;       ///< the settling detector's averaging window (10 ms)
+  double max_level_s = 60.0;    ///< a level that never settles fails the run
+  double ramp_down_s = 0.05;    ///< current to zero at the end
+};
+
+/// The rules (docs/identification.md, "Test levels and gains"):
+/// * base impedance Z_b = V_LL / (sqrt(3) I_rated); the transient inductance of a standard
+///   motor is 0.1..0.2 per unit: sigma Ls ~ 0.15 Z_b / omega_rated;
+/// * DC levels at 0.3 and 0.6 of the rated peak current (never above 0.9 of the board's
+///   limit): high enough that no phase current comes near zero, where the dead time's error
+///   changes sign, and low enough not to saturate the iron;
+/// * the PI's crossover omega_c = 2 pi 50 Hz on sigma Ls (Kp = sigma Ls omega_c; Ki = Kp
+///   omega_c / 5): far below the sample rate, so a guess three times off stays stable, and slow
+///   enough that the ADC noise barely reaches the voltage the estimates use;
+/// * the square wave of the sigma Ls step makes a current ripple of 0.2 of the high level.
+inline IdentificationPlan plan_identification(const Nameplate& n, double i_max_A, double v_bus_V,
+                                              double period_s) {
+  IdentificationPlan p;
+  p.period_s = period_s;
+  const double i_rated_peak_A = std::sqrt(2.0) * n.rated_current_A;
+  const double i_top_A = std::min(0.6 * i_rated_peak_A, 0.9 * i_max_A);
+  p.i_high_A = i_top_A;
+  p.i_low_A = 0.5 * i_top_A;
+  const double z_base_Ohm = n.rated_voltage_V / (std::sqrt(3.0) * n.rated_current_A);
+  const double omega_rated_rad_s = 2.0 * std::numbers::pi * n.rated_frequency_Hz;
+  p.sigma_Ls_guess_H = 0.15 * z_base_Ohm / omega_rated_rad_s;
+  const double omega_c_rad_s = 2.0 * std::numbers::pi * 50.0;
+  p.kp_Ohm = p.sigma_Ls_guess_H * omega_c_rad_s;
+  p.ki_Ohm_per_s = p.kp_Ohm * omega_c_rad_s / 5.0;
+  p.v_limit_V = 0.95 * v_bus_V / std::sqrt(3.0);
+  const double ripple_A = 0.2 * p.i_high_A;
+  p.hf_voltage_V = std::min(ripple_A * p.sigma_Ls_guess_H / (p.hf_half_period_ticks * period_s),
+                            0.3 * p.v_limit_V);
+  return p;
+}
+
+}  // namespace imd::firmware
