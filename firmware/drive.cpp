@@ -6,14 +6,14 @@
 namespace imd::firmware {
 
 template <typename T>
-std::optional<MotorModel<T>> Drive<T>::build(const std::optional<control::MotorParameters>& motor,
+std::optional<MotorModel<T>> Drive<T>::build(const std::optional<MotorRecord>& record,
                                              const DriveConfig& config, const BoardScales& board) {
-  if (!motor) return std::nullopt;
-  return std::optional<MotorModel<T>>(std::in_place, *motor, config, board);
+  if (!record) return std::nullopt;
+  return std::optional<MotorModel<T>>(std::in_place, record->motor, config, board);
 }
 
 template <typename T>
-Drive<T>::Drive(const std::optional<control::MotorParameters>& motor, const DriveConfig& config,
+Drive<T>::Drive(const std::optional<MotorRecord>& record, const DriveConfig& config,
                 const DrivePeripherals& peripherals, const DriveSubstitutes<T>& substitutes)
     : config_(config),
       hw_(peripherals),
@@ -23,8 +23,8 @@ Drive<T>::Drive(const std::optional<control::MotorParameters>& motor, const Driv
       board_sensing_(peripherals.adc, peripherals.encoder,
                      {config.adc_calibration_ticks, config.adc_offset_limit_A}),
       sensing_(substitutes.sensing != nullptr ? *substitutes.sensing : board_sensing_),
-      bank_(motor),
-      model_(build(motor, config, board_)),
+      bank_(record),
+      model_(build(record, config, board_)),
       model_ready_(model_.has_value()),
       attached_(model_ ? &*model_ : nullptr),
       protection_(config),

@@ -66,10 +66,10 @@ struct DriveSubstitutes {
 template <typename T>
 class Drive final : public hal::TickHandler {
  public:
-  /// Wires the drive; no allocation after this. `motor`: the record loaded from storage
+  /// Wires the drive; no allocation after this. `record`: the motor record loaded from storage
   /// (firmware/parameters/motor_record.hpp), valid; without one the drive waits, unconfigured,
   /// for a record written over CAN.
-  Drive(const std::optional<control::MotorParameters>& motor, const DriveConfig& config,
+  Drive(const std::optional<MotorRecord>& record, const DriveConfig& config,
         const DrivePeripherals& peripherals, const DriveSubstitutes<T>& substitutes = {});
   Drive(const Drive&) = delete;
   Drive& operator=(const Drive&) = delete;
@@ -124,7 +124,7 @@ class Drive final : public hal::TickHandler {
   [[gnu::always_inline]] void publish(uint64_t k, const Measurement<T>& m, const Estimate<T>& e,
                                       const TickPlan<T>& plan, const LawOutput<T>& u,
                                       const Modulation<T>& out, MotorModel<T>* model) noexcept;
-  static std::optional<MotorModel<T>> build(const std::optional<control::MotorParameters>& motor,
+  static std::optional<MotorModel<T>> build(const std::optional<MotorRecord>& record,
                                             const DriveConfig& config, const BoardScales& board);
   void pwm_off() noexcept;
   /// Drives one of the board's output lines (nothing when the line is not wired).

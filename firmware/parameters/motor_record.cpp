@@ -15,8 +15,8 @@ double field_value(const control::MotorParameters& m, MotorField field) noexcept
     case MotorField::J_kgm2: return m.J_kgm2;
     case MotorField::pole_pairs: return double(m.pole_pairs);
     case MotorField::friction_Nms: return m.friction_Nms;
+    default: return 0.0;
   }
-  return 0.0;
 }
 
 void set_field(control::MotorParameters& m, MotorField field, double value) noexcept {
@@ -29,6 +29,29 @@ void set_field(control::MotorParameters& m, MotorField field, double value) noex
     case MotorField::J_kgm2: m.J_kgm2 = value; break;
     case MotorField::pole_pairs: m.pole_pairs = static_cast<int>(std::lround(value)); break;
     case MotorField::friction_Nms: m.friction_Nms = value; break;
+    default: break;
+  }
+}
+
+double field_value(const MotorRecord& r, MotorField field) noexcept {
+  switch (field) {
+    case MotorField::rated_voltage_V: return r.nameplate.rated_voltage_V;
+    case MotorField::rated_current_A: return r.nameplate.rated_current_A;
+    case MotorField::rated_frequency_Hz: return r.nameplate.rated_frequency_Hz;
+    default: return field_value(r.motor, field);
+  }
+}
+
+void set_field(MotorRecord& r, MotorField field, double value) noexcept {
+  switch (field) {
+    case MotorField::rated_voltage_V: r.nameplate.rated_voltage_V = value; break;
+    case MotorField::rated_current_A: r.nameplate.rated_current_A = value; break;
+    case MotorField::rated_frequency_Hz: r.nameplate.rated_frequency_Hz = value; break;
+    case MotorField::pole_pairs:
+      set_field(r.motor, field, value);
+      r.nameplate.pole_pairs = r.motor.pole_pairs;
+      break;
+    default: set_field(r.motor, field, value); break;
   }
 }
 
@@ -56,15 +79,14 @@ ParameterStatus check_record(const control::MotorParameters& motor) noexcept {
                                                 : ParameterStatus::ok;
 }
 
-std::array<uint8_t, kMotorRecordBytes> encode_motor_record(
-    const control::MotorParameters& motor) noexcept {
+std::array<uint8_t, kMotorRecordBytes> encode_motor_record(const MotorRecord& record) noexcept {
   std::array<uint8_t, kMotorRecordBytes> out{};
   out[0] = static_cast<uint8_t>(kMotorRecordVersion);
   out[1] = static_cast<uint8_t>(kMotorRecordVersion >> 8);
-  out[2] = kMotorFieldCount;
+  out[2] = kRecordFieldCount;
   out[3] = 0;
-  for (int i = 0; i < kMotorFieldCount; ++i) {
-    const double v = field_value(motor, static_cast<MotorField>(i));
+  for (int i = 0; i < kRecordFieldCount; ++i) {
+    const double v = field_value(record, static_cast<MotorField>(i));
     uint64_t bits = 0;
     std::memcpy(&bits, &v, sizeof bits);
     for (int b = 0; b < 8; ++b) out[4 + 8 * i + b] = static_cast<uint8_t>(bits >> (8 * b));
@@ -72,23 +94,23 @@ std::array<uint8_t, kMotorRecordBytes> encode_motor_record(
   return out;
 }
 
-std::optional<control::MotorParameters> decode_motor_record(
-    std::span<const uint8_t> bytes) noexcept {
+std::optional<MotorRecord> decode_motor_record(std::span<const uint8_t> bytes) noexcept {
   if (bytes.size() != kMotorRecordBytes) return std::nullopt;
   const uint16_t version = static_cast<uint16_t>(bytes[0] | bytes[1] << 8);
-  if (version != kMotorRecordVersion || bytes[2] != kMotorFieldCount) return std::nullopt;
-  control::MotorParameters motor;
-  for (int i = 0; i < kMotorFieldCount; ++i) {
+  if (version != kMotorRecordVersion || bytes[2] != kRecordFieldCount) return std::nullopt;
+  MotorRecord record;
+  for (int i = 0; i < kRecordFieldCount; ++i) {
     uint64_t bits = 0;
     for (int b = 0; b < 8; ++b) bits |= uint64_t(bytes[4 + 8 * i + b]) << (8 * b);
     double v = 0.0;
     std::memcpy(&v, &bits, sizeof v);
     const auto field = static_cast<MotorField>(i);
-    if (check_field(field, v) != ParameterStatus::ok) return std::nullopt;
-    set_field(motor, field, v);
+    const bool unset_nameplate = i >= kMotorFieldCount && v == 0.0;
+    if (!unset_nameplate && check_field(field, v) != ParameterStatus::ok) return std::nullopt;
+    set_field(record, field, v);
   }
-  if (check_record(motor) != ParameterStatus::ok) return std::nullopt;
-  return motor;
+  if (check_record(record.motor) != ParameterStatus::ok) return std::nullopt;
+  return record;
 }
 
 }  // namespace imd::firmware

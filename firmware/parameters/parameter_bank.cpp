@@ -4,9 +4,28 @@
 
 namespace imd::firmware {
 
-ParameterBank::ParameterBank(const std::optional<control::MotorParameters>& loaded) noexcept
-    : staged_(loaded.value_or(control::MotorParameters{0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0, 0.0})),
-      set_fields_(loaded ? kAllFields : 0u),
+namespace {
+/// The fields of a loaded record that have values: the motor's all, the nameplate's if given.
+uint32_t fields_of(const std::optional<MotorRecord>& loaded) noexcept {
+  if (!loaded) return 0u;
+  uint32_t fields = (1u << kMotorFieldCount) - 1;
+  for (int i = kMotorFieldCount; i < kRecordFieldCount; ++i) {
+    if (field_value(*loaded, MotorField(i)) > 0.0) fields |= 1u << i;
+  }
+  return fields;
+}
+
+MotorRecord empty_record() noexcept {
+  MotorRecord r;
+  r.motor = control::MotorParameters{0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0, 0.0};
+  r.nameplate = Nameplate{};
+  return r;
+}
+}  // namespace
+
+ParameterBank::ParameterBank(const std::optional<MotorRecord>& loaded) noexcept
+    : staged_(loaded.value_or(empty_record())),
+      set_fields_(fields_of(loaded)),
       saved_(loaded.has_value()) {}
 
 bool ParameterBank::submit(const ParameterAccess& access) noexcept {
@@ -30,12 +49,17 @@ void ParameterBank::request_apply() noexcept {
 }
 
 std::optional<control::MotorParameters> ParameterBank::record() const noexcept {
-  if (set_fields_ != kAllFields) return std::nullopt;
-  return staged_;
+  if (!complete()) return std::nullopt;
+  return staged_.motor;
+}
+
+std::optional<Nameplate> ParameterBank::nameplate() const noexcept {
+  if ((set_fields_ & kNameplateFields) != kNameplateFields) return std::nullopt;
+  return staged_.nameplate;
 }
 
 ParameterStatus ParameterBank::read(uint8_t field, double& value) const noexcept {
-  if (field >= kMotorFieldCount) return ParameterStatus::unknown_field;
+  if (field >= kRecordFieldCount) return ParameterStatus::unknown_field;
   if ((set_fields_ & (1u << field)) == 0) return ParameterStatus::not_set;
   value = field_value(staged_, static_cast<MotorField>(field));
   return ParameterStatus::ok;
@@ -44,20 +68,24 @@ ParameterStatus ParameterBank::read(uint8_t field, double& value) const noexcept
 ParameterStatus ParameterBank::write(uint8_t field, double value, bool at_rest,
                                      bool& changed) noexcept {
   changed = false;
-  if (field >= kMotorFieldCount) return ParameterStatus::unknown_field;
+  if (field >= kRecordFieldCount) return ParameterStatus::unknown_field;
   if (!at_rest) return ParameterStatus::not_idle;
   const auto f = static_cast<MotorField>(field);
   if (const ParameterStatus s = check_field(f, value); s != ParameterStatus::ok) return s;
-  control::MotorParameters candidate = staged_;
+  MotorRecord candidate = staged_;
   set_field(candidate, f, value);
   const uint32_t fields = set_fields_ | (1u << field);
-  if (fields == kAllFields) {
-    if (const ParameterStatus s = check_record(candidate); s != ParameterStatus::ok) return s;
+  const bool motor_complete = (fields & kMotorFields) == kMotorFields;
+  if (motor_complete) {
+    if (const ParameterStatus s = check_record(candidate.motor); s != ParameterStatus::ok) {
+      return s;
+    }
   }
   staged_ = candidate;
   set_fields_ = fields;
   saved_ = false;
-  changed = fields == kAllFields;
+  // Only the motor's fields make a new model; the nameplate is for the next commissioning.
+  changed = motor_complete && field < kMotorFieldCount;
   return ParameterStatus::ok;
 }
 
@@ -72,7 +100,7 @@ void ParameterBank::serve(hal::ParameterStore* store) noexcept {
       a.status = write(access_.field, double(access_.value), access_.at_rest, a.apply);
       break;
     case protocol::ParameterOp::save:
-      if (set_fields_ != kAllFields) {
+      if (!complete()) {
         a.status = ParameterStatus::not_set;
       } else if (store == nullptr || !store->save(encode_motor_record(staged_))) {
         a.status = ParameterStatus::store_failed;
@@ -86,7 +114,7 @@ void ParameterBank::serve(hal::ParameterStore* store) noexcept {
   if (access_.op == protocol::ParameterOp::read) a.status = read_status;
   a.value = read_status == ParameterStatus::ok ? static_cast<float>(value)
                                                : std::numeric_limits<float>::quiet_NaN();
-  a.complete = set_fields_ == kAllFields;
+  a.complete = complete();
   a.saved = saved_;
   answer_ = a;
   stage_.store(Stage::answered, std::memory_order_release);

@@ -44,7 +44,7 @@ class ParameterBank {
   enum class Stage : uint8_t { free, access, answered, apply };
 
   /// `loaded`: the record read from storage at start-up (none: the drive waits for one).
-  explicit ParameterBank(const std::optional<control::MotorParameters>& loaded) noexcept;
+  explicit ParameterBank(const std::optional<MotorRecord>& loaded) noexcept;
 
   // --- tick side
 
@@ -65,18 +65,23 @@ class ParameterBank {
 
   /// Serves a submitted access (reads, checks and stages a write, saves to `store`).
   void serve(hal::ParameterStore* store) noexcept;
-  /// The record the new model is built from (stage apply), then frees the bank.
-  const control::MotorParameters& staged() const noexcept { return staged_; }
+  /// The motor the new model is built from (stage apply), then frees the bank.
+  const control::MotorParameters& staged() const noexcept { return staged_.motor; }
   void applied() noexcept { stage_.store(Stage::free, std::memory_order_release); }
-  /// Outside the tick: the record, if complete.
+  /// Outside the tick: the motor, if its record is complete.
   std::optional<control::MotorParameters> record() const noexcept;
+  /// Outside the tick: the nameplate, if every field of it has a value.
+  std::optional<Nameplate> nameplate() const noexcept;
 
  private:
-  static constexpr uint32_t kAllFields = (1u << kMotorFieldCount) - 1;
+  static constexpr uint32_t kMotorFields = (1u << kMotorFieldCount) - 1;
+  static constexpr uint32_t kNameplateFields =
+      ((1u << kRecordFieldCount) - 1 - kMotorFields) | (1u << int(MotorField::pole_pairs));
+  bool complete() const noexcept { return (set_fields_ & kMotorFields) == kMotorFields; }
   ParameterStatus read(uint8_t field, double& value) const noexcept;
   ParameterStatus write(uint8_t field, double value, bool at_rest, bool& changed) noexcept;
 
-  control::MotorParameters staged_;
+  MotorRecord staged_;
   uint32_t set_fields_;
   bool saved_;
   ParameterAccess access_;  ///< written by the tick (stage free -> access)

@@ -111,8 +111,10 @@ inline constexpr ValueName kTransitionReasonValues[] = {
     {8, "parameters_written"}, {9, "configured"},
 };
 inline constexpr ValueName kMotorFieldValues[] = {
-    {0, "Rs_Ohm"}, {1, "Ls_H"},   {2, "Lm_H"},       {3, "Rr_Ohm"},
-    {4, "Lr_H"},   {5, "J_kgm2"}, {6, "pole_pairs"}, {7, "friction_Nms"},
+    {0, "Rs_Ohm"},          {1, "Ls_H"},            {2, "Lm_H"},
+    {3, "Rr_Ohm"},          {4, "Lr_H"},            {5, "J_kgm2"},
+    {6, "pole_pairs"},      {7, "friction_Nms"},    {8, "rated_voltage_V"},
+    {9, "rated_current_A"}, {10, "rated_frequency_Hz"},
 };
 inline constexpr ValueName kParameterOpValues[] = {{0, "read"}, {1, "write"}, {2, "save"}};
 inline constexpr ValueName kParameterStatusValues[] = {

@@ -32,11 +32,11 @@ class SimulatedDrive {
   /// config takes them from CAN). `timer`: the board's lock-step timer or a real-time one;
   /// `can`, `gpio`: the board's, a real bus and lines, or none. `store`: a parameter store of
   /// the host's (a file) instead of the board's flash; the drive loads from it, `motor` aside.
-  SimulatedDrive(SimBoard& board, const std::optional<control::MotorParameters>& motor,
+  SimulatedDrive(SimBoard& board, const std::optional<firmware::MotorRecord>& motor,
                  const firmware::DriveConfig& config, const SimulatedParts& parts,
                  const firmware::ReferenceSource<T>* references, hal::ControlTimer& timer,
                  hal::CanBus* can, hal::Gpio* gpio = nullptr, hal::ParameterStore* store = nullptr)
-      : ideal_(board, motor.value_or(board.plant().motor()), config),
+      : ideal_(board, motor ? motor->motor : board.plant().motor(), config),
         analog_(board),
         current_source_(board),
         flash_store_(flash_),
@@ -53,8 +53,8 @@ class SimulatedDrive {
  private:
   /// Writes `motor` to the board's store, then loads what the store holds: what the drive
   /// starts from is what a board would read after power-up.
-  std::optional<control::MotorParameters> stored(
-      const std::optional<control::MotorParameters>& motor) noexcept {
+  std::optional<firmware::MotorRecord> stored(
+      const std::optional<firmware::MotorRecord>& motor) noexcept {
     if (motor) store_.save(firmware::encode_motor_record(*motor));
     std::array<uint8_t, firmware::kMotorRecordBytes> bytes{};
     const std::size_t n = store_.load(bytes);

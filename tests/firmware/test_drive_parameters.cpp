@@ -62,7 +62,7 @@ struct ParameterRig {
     return c;
   }
   /// `flash`: the board's parameter pages, which outlive a power cycle.
-  ParameterRig(sim::SimFlashPages& pages, const std::optional<control::MotorParameters>& loaded)
+  ParameterRig(sim::SimFlashPages& pages, const std::optional<MotorRecord>& loaded)
       : board(paper_motor(), {}),
         flash(pages),
         store(pages),
@@ -105,7 +105,7 @@ struct ParameterRig {
 };
 
 /// Loads what the pages hold, as the next power-up does.
-std::optional<control::MotorParameters> stored(sim::SimFlashPages& pages) {
+std::optional<MotorRecord> stored(sim::SimFlashPages& pages) {
   Store store(pages);
   std::array<uint8_t, kMotorRecordBytes> bytes{};
   const std::size_t n = store.load(bytes);
@@ -214,10 +214,28 @@ TEST(DriveParameters, EveryInvalidWriteIsRefusedWithItsReasonAndChangesNothing) 
   }
   // An unknown field.
   rig.sent.clear();
-  rig.send({CommandKind::parameter_access, 1.0f, ParameterOp::write, 200});
+  rig.send({CommandKind::parameter_access, 1.0f, ParameterOp::write, kRecordFieldCount});
   rig.run(3);
   ASSERT_EQ(rig.answers().size(), 1u);
   EXPECT_EQ(rig.answers()[0].status, ParameterStatus::unknown_field);
+}
+
+TEST(DriveParameters, TheNameplateIsStoredWithoutChangingTheModel) {
+  sim::SimFlashPages pages;
+  ParameterRig rig(pages, paper_motor());
+  rig.run(300);
+  rig.sent.clear();
+  rig.write(MotorField::rated_voltage_V, 220.0);
+  rig.run(3);
+  ASSERT_EQ(rig.answers().size(), 1u);
+  EXPECT_EQ(rig.answers()[0].status, ParameterStatus::ok);
+  EXPECT_EQ(rig.drive.state(), DriveState::idle);  // no new model: the motor did not change
+  EXPECT_EQ(rig.drive.state_machine().entered(DriveState::unconfigured), 0u);
+  EXPECT_EQ(rig.answers()[0].value, 220.0f);
+  rig.send({CommandKind::parameter_access, 0.0f, ParameterOp::read,
+            uint8_t(MotorField::rated_current_A)});
+  rig.run(3);
+  EXPECT_EQ(rig.answers().back().status, ParameterStatus::not_set);
 }
 
 TEST(DriveParameters, AWriteWhileRunningIsRefusedAndTheDriveRunsOn) {
@@ -271,7 +289,7 @@ TEST(DriveParameters, ASavedRecordIsWhatTheNextPowerUpStartsFrom) {
   }
   const auto loaded = stored(pages);  // power cycle
   ASSERT_TRUE(loaded.has_value());
-  EXPECT_DOUBLE_EQ(loaded->J_kgm2, double(0.02f));
+  EXPECT_DOUBLE_EQ(loaded->motor.J_kgm2, double(0.02f));
   ParameterRig next(pages, loaded);
   next.run(300);
   EXPECT_EQ(next.drive.state(), DriveState::idle);
@@ -295,7 +313,7 @@ TEST(DriveParameters, ASaveThatTheStoreRefusesIsReportedAndTheRecordStaysInUse) 
   pages.restore_power();
   const auto old = stored(pages);
   ASSERT_TRUE(old.has_value());
-  EXPECT_DOUBLE_EQ(old->J_kgm2, paper_motor().J_kgm2);  // the old copy, whole
+  EXPECT_DOUBLE_EQ(old->motor.J_kgm2, paper_motor().J_kgm2);  // the old copy, whole
 }
 
 }  // namespace

@@ -24,6 +24,20 @@ TEST(MotorRecord, EveryTestMotorRoundTripsExactly) {
   }
 }
 
+TEST(MotorRecord, TheNameplateTravelsWithTheMotorAndMayBeMissing) {
+  MotorRecord r(imd::test::test_motors().front().parameters);
+  EXPECT_EQ(decode_motor_record(encode_motor_record(r))->nameplate.rated_voltage_V, 0.0);
+  r.nameplate = {400.0, 1.9, 50.0, r.motor.pole_pairs};
+  const auto back = decode_motor_record(encode_motor_record(r));
+  ASSERT_TRUE(back.has_value());
+  EXPECT_EQ(back->nameplate.rated_voltage_V, 400.0);
+  EXPECT_EQ(back->nameplate.rated_current_A, 1.9);
+  EXPECT_EQ(back->nameplate.rated_frequency_Hz, 50.0);
+  EXPECT_EQ(field_value(*back, MotorField::rated_current_A), 1.9);
+  r.nameplate.rated_current_A = -1.0;  // a nameplate value is positive when given
+  EXPECT_FALSE(decode_motor_record(encode_motor_record(r)).has_value());
+}
+
 TEST(MotorRecord, FieldRules) {
   const double nan = std::numeric_limits<double>::quiet_NaN();
   const double inf = std::numeric_limits<double>::infinity();
@@ -38,6 +52,8 @@ TEST(MotorRecord, FieldRules) {
   EXPECT_EQ(check_field(MotorField::pole_pairs, 2.5), ParameterStatus::not_whole);
   EXPECT_EQ(check_field(MotorField::pole_pairs, 0.0), ParameterStatus::not_whole);
   EXPECT_EQ(check_field(MotorField::pole_pairs, kMaxPolePairs + 1.0), ParameterStatus::not_whole);
+  EXPECT_EQ(check_field(MotorField::rated_voltage_V, 0.0), ParameterStatus::not_positive);
+  EXPECT_EQ(check_field(MotorField::rated_frequency_Hz, 50.0), ParameterStatus::ok);
 }
 
 TEST(MotorRecord, CouplingRuleIsTheMotorFilesRule) {
@@ -52,9 +68,11 @@ TEST(MotorRecord, DecodeRefusesOtherVersionsLengthsAndInvalidRecords) {
   const MotorParameters m = imd::test::test_motors().front().parameters;
   auto bytes = encode_motor_record(m);
   EXPECT_FALSE(decode_motor_record(std::span<const uint8_t>(bytes).first(bytes.size() - 1)));
-  auto other_version = bytes;
-  other_version[0] = 2;
-  EXPECT_FALSE(decode_motor_record(other_version));
+  for (const uint8_t version : {uint8_t(kMotorRecordVersion - 1), uint8_t(kMotorRecordVersion + 1)}) {
+    auto other_version = bytes;
+    other_version[0] = version;
+    EXPECT_FALSE(decode_motor_record(other_version)) << int(version);
+  }
   MotorParameters bad = m;
   bad.Rs_Ohm = -bad.Rs_Ohm;
   EXPECT_FALSE(decode_motor_record(encode_motor_record(bad)));

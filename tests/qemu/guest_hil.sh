@@ -88,7 +88,7 @@ say "motor parameters over CAN: unconfigured start, refused writes, a whole moto
 rm -f /tmp/motor.rec
 drive_hil $S/hil.toml $NODE --parameters /tmp/motor.rec --duration-s 100 > /tmp/param_hil.log 2>&1 &
 HIL=$!
-P="drive_monitor parameters $NODE --wait-s 5"
+P="drive_monitor parameters $NODE --wait-s 5 --wait-heartbeat-s 5"
 {
   sleep 1
   echo "step read"; $P; echo "exit $?"

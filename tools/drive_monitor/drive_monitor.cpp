@@ -6,7 +6,7 @@
 //   drive_monitor send --can IFACE --node N COMMAND [VALUE] [--counter C] [--wait-heartbeat-s S]
 //                      [--wait-ack-s S] [--repeat-hz F --for-s S]
 //   drive_monitor parameters --can IFACE --node N [--set KEY=VALUE]... [--motor-file PATH]
-//                            [--save] [--motor-out PATH] [--wait-s S]
+//                            [--save] [--motor-out PATH] [--wait-s S] [--wait-heartbeat-s S]
 //
 // watch decodes node N's frames (default 1); the CSV's time_s is the log's timestamp, or with
 // --can the seconds since watch started. send learns the alive counter from the heartbeat.

@@ -80,6 +80,10 @@ CLI::App* add_parameters_command(CLI::App& app, ParametersOptions& o) {
   c->add_option("--wait-s", o.wait_s, "How long to wait for each answer")
       ->check(kSeconds)
       ->capture_default_str();
+  c->add_option("--wait-heartbeat-s", o.wait_heartbeat_s,
+                "How long to wait for the heartbeat (it gives the alive counter)")
+      ->check(kSeconds)
+      ->capture_default_str();
   return c;
 }
 
@@ -113,7 +117,9 @@ int run_parameters(const ParametersOptions& o) {
     return last.has_value();
   });
   if (!last) {
-    return fail("no heartbeat from node " + std::to_string(o.node) + " on " + o.can, kExitNoAnswer);
+    return fail("no heartbeat from node " + std::to_string(o.node) + " on " + o.can + " within " +
+                    seconds_text(o.wait_heartbeat_s) + " s",
+                kExitNoAnswer);
   }
   Session session(*bus, node, static_cast<uint8_t>((*last + 1) & 0x0F), o.wait_s);
 
@@ -142,13 +148,15 @@ int run_parameters(const ParametersOptions& o) {
     if (reply->status != ParameterStatus::ok) status = kExitRejected;
   }
   control::MotorParameters read;
-  bool complete = true, saved = false;
-  for (int i = 0; i < firmware::kMotorFieldCount; ++i) {
+  bool complete = false, saved = false;
+  for (int i = 0; i < firmware::kRecordFieldCount; ++i) {
     const auto reply = session.access(ParameterOp::read, uint8_t(i));
     if (!reply) return fail("read " + field_name(uint8_t(i)) + ": no answer", kExitNoAnswer);
     std::cout << field_name(uint8_t(i)) << " = " << value_text(reply->value) << '\n';
-    if (reply->status != ParameterStatus::ok) complete = false;
-    firmware::set_field(read, static_cast<firmware::MotorField>(i), double(reply->value));
+    if (i < firmware::kMotorFieldCount) {
+      firmware::set_field(read, static_cast<firmware::MotorField>(i), double(reply->value));
+    }
+    complete = reply->complete;  // the motor's fields, as the drive judges them
     saved = reply->saved;
   }
   std::cout << "record: " << (complete ? "complete" : "incomplete") << ", "
