@@ -1,5 +1,8 @@
 #include "firmware/drive.hpp"
 
+#include "control/svpwm.hpp"
+#include "firmware/identification/commissioned_motor.hpp"
+
 #include <algorithm>
 #include <cmath>
 
@@ -57,14 +60,15 @@ void Drive<T>::on_tick() noexcept {
   clock.lap(Stage::supervise);
   const LawOutput<T> u = law(plan, e, m.v_bus_V, model);
   clock.lap(Stage::law);
-  const Modulation<T> out = modulate(plan, u, e, m.v_bus_V, model);
+  const Modulation<T> out = modulate(plan, u, e, m, model);
   clock.lap(Stage::modulate);
   const Trip trip = protection_.check(m, e, plan.supervised, u, out, u_written_V_,
-                                      model != nullptr ? &model->checks : nullptr);
+                                      e.valid ? &model->checks : nullptr);
   clock.lap(Stage::protect);
   actuate(k, e, out, trip, model);
   check_budget(k, clock.lap_total(Stage::actuate), model);
   publish(k, m, e, plan, u, out, model);
+  end_identification(k);
   if (bank_.apply_wanted()) release_model();
   clock.lap(Stage::publish);
   write_line(config_.timing_output_line, false);
@@ -91,7 +95,13 @@ template <typename T>
 void Drive<T>::service() noexcept {
   switch (bank_.stage()) {
     case ParameterBank::Stage::access:
-      bank_.serve(hw_.store);
+      if (bank_.access().op == protocol::ParameterOp::identify) {
+        plan_commissioning();
+      } else if (bank_.access().op == protocol::ParameterOp::identified) {
+        adopt_commissioning();
+      } else {
+        bank_.serve(hw_.store);
+      }
       return;
     case ParameterBank::Stage::apply:
       // The tick let go of the model before it asked: it is the service loop's to rebuild.
@@ -107,13 +117,71 @@ void Drive<T>::service() noexcept {
 }
 
 template <typename T>
+void Drive<T>::plan_commissioning() noexcept {
+  const std::optional<Nameplate> nameplate = bank_.nameplate();
+  if (!nameplate) {
+    bank_.answer(ParameterStatus::not_set);
+    return;
+  }
+  identifier_.emplace(plan_identification(*nameplate, config_.i_max_A,
+                                          double(bank_.access().value), config_.sample_period_s));
+  bank_.answer(ParameterStatus::ok);
+}
+
+template <typename T>
+void Drive<T>::adopt_commissioning() noexcept {
+  // The tick let go of the model when it asked; the identifier has finished.
+  const control::MotorParameters motor =
+      commissioned_motor(identifier_->result(), *bank_.nameplate(), bank_.record());
+  const ParameterStatus status = bank_.adopt(motor, hw_.store);
+  model_.reset();
+  if (const auto record = bank_.record()) {  // the new motor, or the old one if refused
+    model_.emplace(*record, config_, board_);
+    model_ready_.store(true, std::memory_order_release);
+  }
+  bank_.answer(status);
+}
+
+template <typename T>
+Modulation<T> Drive<T>::identify(const Measurement<T>& m) noexcept {
+  Modulation<T> out;
+  if (!m.valid || !identifier_) return out;
+  out.u_alphabeta_V = identifier_->step(m.i_alphabeta_A);
+  const control::SvpwmResult<T> pwm = control::svpwm(out.u_alphabeta_V, m.v_bus_V);
+  for (int phase = 0; phase < 3; ++phase) out.duty[phase] = static_cast<float>(pwm.duty[phase]);
+  out.clipped = pwm.clipped;
+  out.finite = std::isfinite(out.u_alphabeta_V.x()) && std::isfinite(out.u_alphabeta_V.y());
+  supervisor_.identification_progress(static_cast<uint8_t>(identifier_->current_step()),
+                                      static_cast<float>(identifier_->fraction()));
+  return out;
+}
+
+template <typename T>
+void Drive<T>::end_identification(uint64_t k) noexcept {
+  if (supervisor_.state() != DriveState::identifying || !identifier_ ||
+      !identifier_->finished()) {
+    return;
+  }
+  const bool done = identifier_->current_step() == IdentificationStep::done;
+  supervisor_.identification_ended(k, done, static_cast<uint8_t>(identifier_->failure()));
+  pwm_off();
+  if (!done) return;
+  // The new record replaces the model: the service loop builds it from the result.
+  attached_ = nullptr;
+  supervisor_.attach(nullptr, nullptr, k);
+  model_ready_.store(false, std::memory_order_relaxed);
+  bank_.submit({protocol::ParameterOp::identified, 0, 0.0f, true});
+}
+
+template <typename T>
 std::optional<control::MotorParameters> Drive<T>::motor() const noexcept {
   return bank_.record();
 }
 
 template <typename T>
 inline Estimate<T> Drive<T>::estimate(const Measurement<T>& m, MotorModel<T>* model) noexcept {
-  if (!m.valid || model == nullptr) return {};
+  // While the commissioning drives the motor the model's observers have nothing to follow.
+  if (!m.valid || model == nullptr || supervisor_.state() == DriveState::identifying) return {};
   StateEstimator<T>& estimator =
       substitutes_.estimator != nullptr ? *substitutes_.estimator : model->observers;
   Estimate<T> e = estimator.estimate(m);
@@ -138,12 +206,13 @@ inline LawOutput<T> Drive<T>::law(const TickPlan<T>& plan, const Estimate<T>& e,
 
 template <typename T>
 inline Modulation<T> Drive<T>::modulate(const TickPlan<T>& plan, const LawOutput<T>& u,
-                                        const Estimate<T>& e, T v_bus_V,
+                                        const Estimate<T>& e, const Measurement<T>& m,
                                         MotorModel<T>* model) noexcept {
+  if (plan.mode == Mode::identifying) return identify(m);
   if (plan.mode == Mode::off || model == nullptr) return {};
   PowerStage<T>& stage =
       substitutes_.power_stage != nullptr ? *substitutes_.power_stage : model->svpwm;
-  return stage.modulate(u, e.x_input, v_bus_V);
+  return stage.modulate(u, e.x_input, m.v_bus_V);
 }
 
 template <typename T>
@@ -154,6 +223,10 @@ inline void Drive<T>::actuate(uint64_t k, const Estimate<T>& e, const Modulation
     supervisor_.latch(trip, k);
     pwm_off();
     u_written_V_ = Vec2::Zero();
+  } else if (supervisor_.state() == DriveState::identifying) {
+    hw_.pwm.set_duties(out.duty);  // the commissioning's own voltage, no inner feedback
+    hw_.pwm.enable();
+    u_written_V_ = out.u_alphabeta_V;
   } else if (supervisor_.modulating() && model != nullptr) {
     PowerStage<T>& stage =
         substitutes_.power_stage != nullptr ? *substitutes_.power_stage : model->svpwm;

@@ -17,6 +17,7 @@
 #include "firmware/drive_config.hpp"
 #include "firmware/drive_state.hpp"
 #include "firmware/execution_stats.hpp"
+#include "firmware/identification/standstill_identifier.hpp"
 #include "firmware/laws/law_registry.hpp"
 #include "firmware/motor_model.hpp"
 #include "firmware/parameters/parameter_bank.hpp"
@@ -113,8 +114,15 @@ class Drive final : public hal::TickHandler {
   [[gnu::always_inline]] LawOutput<T> law(const TickPlan<T>& plan, const Estimate<T>& e,
                                           T v_bus_V, MotorModel<T>* model) noexcept;
   [[gnu::always_inline]] Modulation<T> modulate(const TickPlan<T>& plan, const LawOutput<T>& u,
-                                                const Estimate<T>& e, T v_bus_V,
+                                                const Estimate<T>& e, const Measurement<T>& m,
                                                 MotorModel<T>* model) noexcept;
+  /// The commissioning's tick: its voltage from the measured current, straight to SVPWM.
+  Modulation<T> identify(const Measurement<T>& m) noexcept;
+  /// After the tick: a finished commissioning hands its result to the service loop.
+  void end_identification(uint64_t k) noexcept;
+  // The service loop's side of the commissioning.
+  void plan_commissioning() noexcept;
+  void adopt_commissioning() noexcept;
   /// The PWM write, or the PWM off with a fault latched; the observers learn what acts.
   [[gnu::always_inline]] void actuate(uint64_t k, const Estimate<T>& e, const Modulation<T>& out,
                                       const Trip& trip, MotorModel<T>* model) noexcept;
@@ -141,6 +149,8 @@ class Drive final : public hal::TickHandler {
   std::optional<MotorModel<T>> model_;
   std::atomic<bool> model_ready_;  ///< model_ is whole: set by service, cleared by the tick
   MotorModel<T>* attached_;        ///< tick side: the model in use, null while none
+  /// Planned by the service loop on an identify command, then run by the tick.
+  std::optional<StandstillIdentifier<T>> identifier_;
   Protection<T> protection_;
   Telemetry telemetry_;
   Supervisor<T> supervisor_;

@@ -18,8 +18,9 @@ enum class DriveState : uint8_t {
   /// PWM off, enable refused: no valid motor record yet, or the one just written is being
   /// applied (the model is rebuilt outside the tick)
   unconfigured,
+  identifying,  ///< the standstill commissioning drives the motor (no torque)
 };
-inline constexpr int kDriveStateCount = 7;
+inline constexpr int kDriveStateCount = 8;
 
 enum class FaultCode : uint8_t {
   none = 0,
@@ -53,6 +54,9 @@ enum class TransitionReason : uint8_t {
   shutdown,  ///< the program running the drive is ending (Linux host-in-the-loop)
   parameters_written,  ///< a parameter write is being applied
   configured,          ///< the motor model is built from a valid record
+  identify,            ///< the commissioning starts
+  identified,          ///< it ended with a new record, being applied
+  identification_failed,  ///< it ended without one (the reason is in identify_progress)
 };
 
 namespace detail {

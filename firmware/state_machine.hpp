@@ -3,6 +3,8 @@
 ///   calibrating -> idle -> magnetizing -> running -> stopping -> idle
 ///   calibrating -> unconfigured -> idle: no motor record, until a valid one is written
 ///   idle -> unconfigured -> idle: a parameter write, while the model is rebuilt
+///   idle or unconfigured -> identifying -> unconfigured: the commissioning run (then idle once
+///   its record is applied; back to idle or unconfigured if it fails or is disabled)
 ///   any state -> fault -> idle (only by clear_faults; to calibrating if the fault came first,
 ///   to unconfigured without a motor record)
 ///   magnetizing, running or stopping -> idle by shutdown only (the program ends, PWM off)
@@ -48,9 +50,11 @@ class StateMachine {
       case S::calibrating:
         return to == S::idle || to == S::unconfigured;
       case S::idle:
-        return to == S::magnetizing || to == S::unconfigured;
+        return to == S::magnetizing || to == S::unconfigured || to == S::identifying;
       case S::unconfigured:
-        return to == S::idle;
+        return to == S::idle || to == S::identifying;
+      case S::identifying:
+        return to == S::unconfigured || to == S::idle;
       case S::magnetizing:
         return to == S::running || to == S::idle;
       case S::running:

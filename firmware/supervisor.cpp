@@ -78,7 +78,20 @@ void Supervisor<T>::select(ControllerKind kind) noexcept {
 template <typename T>
 bool Supervisor<T>::modulating() const noexcept {
   const DriveState s = machine_.state();
-  return s == DriveState::magnetizing || s == DriveState::running || s == DriveState::stopping;
+  return s == DriveState::magnetizing || s == DriveState::running || s == DriveState::stopping ||
+         s == DriveState::identifying;
+}
+
+template <typename T>
+void Supervisor<T>::identification_ended(uint64_t k, bool done, uint8_t failure) noexcept {
+  if (machine_.state() != DriveState::identifying) return;
+  status_.identify_step = done ? 4 : 5;  // kIdentifyStepValues: done, failed
+  status_.identify_failure = failure;
+  status_.identify_fraction = 1.0f;
+  // With a result the model is replaced: unconfigured until the new one is attached.
+  machine_.go(done ? DriveState::unconfigured : rest_state(),
+              done ? TransitionReason::identified : TransitionReason::identification_failed, k);
+  status_.state = machine_.state();
 }
 
 template <typename T>
@@ -94,13 +107,16 @@ TickPlan<T> Supervisor<T>::plan(uint64_t k, const Measurement<T>& m,
   p.mode = Mode::off;
   p.stopping = false;
   enable_input_ = read_enable_input();  // before the commands: enable needs it
+  v_bus_V_ = m.v_bus_V;
   receive_commands(k, p);
   if (machine_.state() == DriveState::calibrating && m.calibration == Calibration::done) {
     calibrated_ = true;
     machine_.go(rest_state(), TransitionReason::calibrated, k);
     if (auto_enable_) enable(k + 1, p);
   }
-  if (modulating() && e.valid) {
+  if (machine_.state() == DriveState::identifying) {
+    p.mode = Mode::identifying;
+  } else if (modulating() && e.valid) {
     references(k, e, p);
     const ControlledFlux flux = controlled_flux_;
     if (machine_.state() == DriveState::magnetizing) {
@@ -172,6 +188,10 @@ void Supervisor<T>::latch(const Trip& trip, uint64_t k) noexcept {
   commanded_.set_speed(T(0));  // after clear and enable, the host sends a new speed
   status_.fault_bits = static_cast<uint16_t>(status_.fault_bits | trip.bits);
   if (machine_.state() == DriveState::fault) return;  // the first fault is kept
+  if (machine_.state() == DriveState::identifying) {
+    status_.identify_step = 5;     // failed
+    status_.identify_failure = 5;  // aborted (by the fault)
+  }
   status_.first_fault = trip.first;
   status_.first_fault_tick = k;
   status_.fault_detail = trip.detail;

@@ -33,6 +33,7 @@ enum class Mode : uint8_t {
   off,          ///< the PWM is off (calibrating, idle, fault)
   magnetizing,  ///< the magnetizing current
   controlling,  ///< the selected law (running or stopping)
+  identifying,  ///< the standstill commissioning drives the motor
 };
 
 template <typename T>
@@ -75,6 +76,13 @@ class Supervisor {
   void latch(const Trip& trip, uint64_t k) noexcept;
   /// The program running the drive ends: to idle if modulating (the motor coasts).
   void shut_down(uint64_t k) noexcept;
+  /// The commissioning run ended at tick k: with a result (`done`), or with `failure`.
+  void identification_ended(uint64_t k, bool done, uint8_t failure) noexcept;
+  /// Its progress, for the telemetry.
+  void identification_progress(uint8_t step, float fraction) noexcept {
+    status_.identify_step = step;
+    status_.identify_fraction = fraction;
+  }
 
   DriveState state() const noexcept { return machine_.state(); }
   bool modulating() const noexcept;
@@ -128,6 +136,7 @@ class Supervisor {
   uint64_t stop_timeout_ticks_;
   bool calibrated_;
   bool record_complete_, record_saved_;  ///< as the last parameter answer said
+  T v_bus_V_ = T(0);                     ///< measured this tick (the commissioning's plan)
   bool enable_input_ = true;  ///< read at the start of the stage
   uint64_t magnetizing_start_tick_ = 0, last_command_tick_ = 0, stop_start_tick_ = 0;
 };

@@ -72,7 +72,9 @@ protocol::CommandResult Supervisor<T>::apply(const protocol::Command& c, uint64_
                  : CommandResult::not_allowed;
     case CommandKind::disable:
       commanded_.set_speed(T(0));          // a later enable waits for a new speed
-      if (s == DriveState::magnetizing) {  // no motion to stop yet: the PWM goes off
+      if (s == DriveState::identifying) {  // the commissioning is aborted, the PWM goes off
+        identification_ended(k, false, 5);  // aborted
+      } else if (s == DriveState::magnetizing) {  // no motion to stop yet: the PWM goes off
         machine_.go(DriveState::idle, TransitionReason::disable, k);
       } else if (s == DriveState::running) {
         machine_.go(DriveState::stopping, TransitionReason::disable, k);
@@ -112,6 +114,17 @@ protocol::CommandResult Supervisor<T>::apply(const protocol::Command& c, uint64_
                  : CommandResult::out_of_range;
     case CommandKind::parameter_access:
       return access_parameter(c, k, p);
+    case CommandKind::identify: {
+      // Planned from the record's nameplate by the service loop (Drive::service); running
+      // once it answers.
+      const bool at_rest = s == DriveState::idle || s == DriveState::unconfigured;
+      if (!at_rest || !enable_input_ || wiring_.parameters == nullptr) {
+        return CommandResult::not_allowed;
+      }
+      const ParameterAccess request{protocol::ParameterOp::identify, 0, float(v_bus_V_), true};
+      return wiring_.parameters->submit(request) ? CommandResult::accepted
+                                                 : CommandResult::not_allowed;
+    }
   }
   return CommandResult::unknown_message;
 }
@@ -147,6 +160,27 @@ void Supervisor<T>::answer_served_access(uint64_t k) noexcept {
   if (!a) return;
   record_complete_ = a->complete;
   record_saved_ = a->saved;
+  if (a->access.op == protocol::ParameterOp::identify) {
+    if (a->status == ParameterStatus::ok &&
+        machine_.go(DriveState::identifying, TransitionReason::identify, k)) {
+      status_.identify_step = 0;
+      status_.identify_failure = 0;
+      status_.identify_fraction = 0.0f;
+      status_.identify_start_tick = k;
+    } else {
+      status_.identify_step = 5;                                   // failed
+      status_.identify_failure = a->status == ParameterStatus::not_set ? 4 : 5;  // no nameplate
+    }
+    status_.state = machine_.state();
+    return;
+  }
+  if (a->access.op == protocol::ParameterOp::identified) {
+    if (a->status != ParameterStatus::ok && a->status != ParameterStatus::store_failed) {
+      status_.identify_step = 5;
+      status_.identify_failure = 6;  // invalid_record
+    }
+    return;  // the new model's attachment moves the drive on (configured)
+  }
   answer_parameter(*a);
   // The drive lets go of its model at the end of this tick; unconfigured until the new one.
   if (a->apply && machine_.state() == DriveState::idle) {

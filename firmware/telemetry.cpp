@@ -9,6 +9,8 @@ namespace imd::firmware {
 using protocol::encode_frame;
 using protocol::MessageId;
 
+constexpr uint8_t kNoIdentification = 6;  // kIdentifyStepValues' "none"
+
 Telemetry::Telemetry(uint8_t node_id, uint32_t period_ns, int rate_Hz,
                      float ns_per_count) noexcept
     : node_id_(node_id),
@@ -58,6 +60,12 @@ void Telemetry::publish(uint64_t k, hal::CanBus& can, const TickRecord<T>& r,
   send_state_changes(can, machine);
   if (k >= next_heartbeat_k_) {
     send_heartbeat(can, status, machine);
+    if (status.identify_step != kNoIdentification) {  // a commissioning ran: its progress
+      const float seconds = float(k - status.identify_start_tick) * float(period_ns_) * 1e-9f;
+      send(can, encode_frame(node_id_, MessageId::identify_progress,
+                             {float(status.identify_step), status.identify_fraction,
+                              float(status.identify_failure), seconds}));
+    }
     next_heartbeat_k_ = next_due(next_heartbeat_k_, k, ticks_per_10Hz_);
   }
   if (k >= next_timing_k_) {  // between heartbeats, to spread the load

@@ -26,6 +26,11 @@ struct DriveStatus {
   uint8_t command_counter = 0;
   uint32_t rejected_commands = 0;
   bool can_bus_off = false;
+  // The last commissioning run: its step (kIdentifyStepValues; 6 none yet), progress and end.
+  uint8_t identify_step = 6;
+  float identify_fraction = 0.0f;
+  uint8_t identify_failure = 0;
+  uint64_t identify_start_tick = 0;
 };
 
 class Telemetry {

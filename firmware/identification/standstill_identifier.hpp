@@ -29,6 +29,9 @@ enum class IdentificationFailure : uint8_t {
   not_settled,     ///< a level did not settle within max_level_s
   voltage_limit,   ///< the loop needed more voltage than the inverter has
   implausible,     ///< a result is not positive or not finite (no motor connected?)
+  no_nameplate,    ///< the record has no complete nameplate to plan the test from
+  aborted,         ///< a disable command or a fault stopped it
+  invalid_record,  ///< the results make no valid motor (e.g. no leakage)
 };
 
 template <typename T>

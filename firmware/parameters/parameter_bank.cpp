@@ -89,6 +89,27 @@ ParameterStatus ParameterBank::write(uint8_t field, double value, bool at_rest,
   return ParameterStatus::ok;
 }
 
+void ParameterBank::answer(ParameterStatus status) noexcept {
+  ParameterAnswer a;
+  a.access = access_;
+  a.status = status;
+  a.value = std::numeric_limits<float>::quiet_NaN();
+  a.complete = complete();
+  a.saved = saved_;
+  answer_ = a;
+  stage_.store(Stage::answered, std::memory_order_release);
+}
+
+ParameterStatus ParameterBank::adopt(const control::MotorParameters& motor,
+                                     hal::ParameterStore* store) noexcept {
+  if (const ParameterStatus s = check_record(motor); s != ParameterStatus::ok) return s;
+  staged_.motor = motor;
+  staged_.nameplate.pole_pairs = motor.pole_pairs;
+  set_fields_ |= kMotorFields;
+  saved_ = store != nullptr && store->save(encode_motor_record(staged_));
+  return saved_ ? ParameterStatus::ok : ParameterStatus::store_failed;
+}
+
 void ParameterBank::serve(hal::ParameterStore* store) noexcept {
   if (stage() != Stage::access) return;
   ParameterAnswer a;
@@ -98,6 +119,10 @@ void ParameterBank::serve(hal::ParameterStore* store) noexcept {
       break;
     case protocol::ParameterOp::write:
       a.status = write(access_.field, double(access_.value), access_.at_rest, a.apply);
+      break;
+    case protocol::ParameterOp::identify:
+    case protocol::ParameterOp::identified:
+      a.status = ParameterStatus::busy;  // the drive's own requests: Drive::service serves them
       break;
     case protocol::ParameterOp::save:
       if (!complete()) {

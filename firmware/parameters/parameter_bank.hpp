@@ -72,6 +72,13 @@ class ParameterBank {
   std::optional<control::MotorParameters> record() const noexcept;
   /// Outside the tick: the nameplate, if every field of it has a value.
   std::optional<Nameplate> nameplate() const noexcept;
+  /// The access being served (stage access).
+  const ParameterAccess& access() const noexcept { return access_; }
+  /// Answers the access with `status` without serving it here (the drive's own requests).
+  void answer(ParameterStatus status) noexcept;
+  /// A whole new motor (a commissioning's result): checked, staged and saved. The nameplate
+  /// stays.
+  ParameterStatus adopt(const control::MotorParameters& motor, hal::ParameterStore* store) noexcept;
 
  private:
   static constexpr uint32_t kMotorFields = (1u << kMotorFieldCount) - 1;

@@ -39,6 +39,8 @@ MessageId message_for(CommandKind kind) noexcept {
       return MessageId::set_telemetry_rate;
     case CommandKind::parameter_access:
       return MessageId::parameter_access;
+    case CommandKind::identify:
+      return MessageId::identify;
   }
   return MessageId::disable;
 }
@@ -91,6 +93,9 @@ Decoded CommandDecoder::decode(const hal::CanFrame& frame) noexcept {
       break;
     case MessageId::clear_faults:
       c.kind = CommandKind::clear_faults;
+      break;
+    case MessageId::identify:
+      c.kind = CommandKind::identify;
       break;
     case MessageId::set_speed:
       c.kind = CommandKind::set_speed;

@@ -27,11 +27,13 @@ enum class CommandKind : uint8_t {
   select_controller,   ///< value: 0 dsmc, 1 iol, 2 ifoc
   set_telemetry_rate,  ///< value: Hz
   parameter_access,    ///< op (read, write, save), field, value (write)
+  identify,            ///< start the commissioning
 };
 
-/// What a parameter_access frame asks (kParameterOpValues).
-enum class ParameterOp : uint8_t { read, write, save };
-inline constexpr int kParameterOpCount = 3;
+/// What a parameter_access frame asks (kParameterOpValues); the last two are the drive's own
+/// requests to its service loop, never on CAN.
+enum class ParameterOp : uint8_t { read, write, save, identify, identified };
+inline constexpr int kParameterOpCount = 3;  ///< the operations a frame may carry
 
 struct Command {
   CommandKind kind = CommandKind::disable;

@@ -32,12 +32,14 @@ enum class MessageId : uint8_t {
   state_change = 0x0C,
   parameter_access = 0x0D,
   parameter_value = 0x0E,
+  identify = 0x0F,
   telemetry_speed_flux = 0x10,
   telemetry_current = 0x11,
   telemetry_voltage = 0x12,
   timing = 0x13,
   stage_timing_1 = 0x14,
   stage_timing_2 = 0x15,
+  identify_progress = 0x16,
 };
 
 enum class Direction : uint8_t {
@@ -80,7 +82,7 @@ constexpr uint8_t message_of(uint16_t can_id) noexcept {
 inline constexpr ValueName kStateValues[] = {
     {0, "calibrating"}, {1, "idle"},     {2, "magnetizing"},
     {3, "running"},     {4, "stopping"}, {5, "fault"},
-    {6, "unconfigured"},
+    {6, "unconfigured"}, {7, "identifying"},
 };
 inline constexpr ValueName kFaultValues[] = {
     {0, "none"},
@@ -108,7 +110,8 @@ inline constexpr ValueName kCommandResultValues[] = {
 inline constexpr ValueName kTransitionReasonValues[] = {
     {0, "calibrated"}, {1, "enable"}, {2, "magnetized"},   {3, "disable"},
     {4, "stopped"},    {5, "fault"},  {6, "clear_faults"}, {7, "shutdown"},
-    {8, "parameters_written"}, {9, "configured"},
+    {8, "parameters_written"}, {9, "configured"}, {10, "identify"}, {11, "identified"},
+    {12, "identification_failed"},
 };
 inline constexpr ValueName kMotorFieldValues[] = {
     {0, "Rs_Ohm"},          {1, "Ls_H"},            {2, "Lm_H"},
@@ -117,6 +120,15 @@ inline constexpr ValueName kMotorFieldValues[] = {
     {9, "rated_current_A"}, {10, "rated_frequency_Hz"},
 };
 inline constexpr ValueName kParameterOpValues[] = {{0, "read"}, {1, "write"}, {2, "save"}};
+inline constexpr ValueName kIdentifyStepValues[] = {
+    {0, "low_level"}, {1, "high_level"}, {2, "transient_inductance"},
+    {3, "ramp_down"}, {4, "done"},       {5, "failed"},
+    {6, "none"},
+};
+inline constexpr ValueName kIdentifyFailureValues[] = {
+    {0, "none"},        {1, "not_settled"}, {2, "voltage_limit"}, {3, "implausible"},
+    {4, "no_nameplate"}, {5, "aborted"},    {6, "invalid_record"},
+};
 inline constexpr ValueName kParameterStatusValues[] = {
     {0, "ok"},         {1, "not_idle"},  {2, "unknown_field"}, {3, "not_finite"},
     {4, "not_positive"}, {5, "negative"}, {6, "not_whole"},     {7, "no_leakage"},
@@ -197,6 +209,14 @@ inline constexpr Signal kParameterValueSignals[] = {
     {"complete", 48, 1, false, 1, 1, 0.0f, "", "every field has a valid value: the drive runs on it"},
     {"saved", 49, 1, false, 1, 1, 0.0f, "", "the record in use is the one in storage"},
 };
+inline constexpr Signal kIdentifyProgressSignals[] = {
+    {"step", 0, 8, false, 1, 1, 0.0f, "", "the commissioning step in progress, or its end",
+     kIdentifyStepValues},
+    {"fraction", 8, 8, false, 1, 200, 0.0f, "", "progress through the step, 0..1"},
+    {"failure", 16, 8, false, 1, 1, 0.0f, "", "why it failed (step failed)",
+     kIdentifyFailureValues},
+    {"seconds", 24, 16, false, 1, 10, 0.0f, "s", "drive time since the run began"},
+};
 inline constexpr Signal kSpeedFluxSignals[] = {
     {"speed_rad_s", 0, 16, true, 1, 100, 0.0f, "rad/s", "estimated mechanical speed"},
     {"speed_ref_rad_s", 16, 16, true, 1, 100, 0.0f, "rad/s", "speed reference (after the ramp)"},
@@ -267,6 +287,13 @@ inline constexpr Message kMessages[] = {
     {MessageId::parameter_value, "parameter_value", 7, Direction::drive_to_host, Timing::on_event,
      0, "the answer to every parameter_access: the value or why it was refused",
      kParameterValueSignals},
+    {MessageId::identify, "identify", 2, Direction::host_to_drive, Timing::on_event, 0,
+     "start the standstill commissioning from the nameplate (idle or unconfigured); disable "
+     "aborts it",
+     kEmptyCommandSignals},
+    {MessageId::identify_progress, "identify_progress", 5, Direction::drive_to_host,
+     Timing::cyclic, 100, "the commissioning's step and progress at 10 Hz while it runs, and "
+     "its end", kIdentifyProgressSignals},
     {MessageId::telemetry_speed_flux, "telemetry_speed_flux", 8, Direction::drive_to_host,
      Timing::configurable, 10, "fast telemetry 1/3", kSpeedFluxSignals},
     {MessageId::telemetry_current, "telemetry_current", 8, Direction::drive_to_host,

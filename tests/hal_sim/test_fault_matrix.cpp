@@ -131,12 +131,13 @@ TEST(FaultMatrix, PhaseLoss) {
 }
 
 TEST(FaultMatrix, Overrun) {
-  // The tick budget is 10 ms of host time: a lock-step run on a shared machine never takes that
-  // long for one tick, while the injected stall of 20 ms always does.
+  // The tick budget is 100 ms of host time: a tick of the lock-step run takes microseconds, and
+  // even a loaded 2-core machine does not deschedule it for that long (10 ms happened), while
+  // the injected stall of 250 ms always overruns it.
   Scenario s = base("seed000_realistic.toml");
-  s.protection.tick_budget_us = 10'000.0;
+  s.protection.tick_budget_us = 100'000.0;
   FaultInjection f = at(kInject_s, FaultKind::overrun);
-  f.stall_us = 20'000.0;
+  f.stall_us = 250'000.0;
   EXPECT_EQ(run_case(s, {f, "overrun", kTick_s}), 0.0);
 }
 
