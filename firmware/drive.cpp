@@ -158,6 +158,10 @@ Modulation<T> Drive<T>::identify(const Measurement<T>& m) noexcept {
 
 template <typename T>
 void Drive<T>::end_identification(uint64_t k) noexcept {
+  if (adopt_pending_) {  // a parameter read was in flight at the end: hand over now
+    adopt_pending_ = !bank_.submit({protocol::ParameterOp::identified, 0, 0.0f, true});
+    return;
+  }
   if (supervisor_.state() != DriveState::identifying || !identifier_ ||
       !identifier_->finished()) {
     return;
@@ -170,7 +174,7 @@ void Drive<T>::end_identification(uint64_t k) noexcept {
   attached_ = nullptr;
   supervisor_.attach(nullptr, nullptr, k);
   model_ready_.store(false, std::memory_order_relaxed);
-  bank_.submit({protocol::ParameterOp::identified, 0, 0.0f, true});
+  adopt_pending_ = !bank_.submit({protocol::ParameterOp::identified, 0, 0.0f, true});
 }
 
 template <typename T>

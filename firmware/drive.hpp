@@ -151,6 +151,7 @@ class Drive final : public hal::TickHandler {
   MotorModel<T>* attached_;        ///< tick side: the model in use, null while none
   /// Planned by the service loop on an identify command, then run by the tick.
   std::optional<StandstillIdentifier<T>> identifier_;
+  bool adopt_pending_ = false;  ///< its result still waits for the bank (tick side)
   Protection<T> protection_;
   Telemetry telemetry_;
   Supervisor<T> supervisor_;

@@ -120,8 +120,11 @@ TEST(DriveIdentification, AnUnknownMotorIsIdentifiedStoredAndRun) {
   ASSERT_EQ(rig.drive.state(), DriveState::identifying);
   int ticks = 0;
   while (rig.drive.state() == DriveState::identifying && ticks < 200'000) {
-    rig.run(100);
-    ticks += 100;
+    // A host reading the record meanwhile: reads are served during the run, and one may be in
+    // flight when it ends (the result then waits for the bank).
+    rig.send({CommandKind::parameter_access, 0.0f, ParameterOp::read, 0});
+    rig.run(1);
+    ticks += 1;
   }
   rig.run(3);  // the record applied outside the tick, the model attached
   ASSERT_EQ(rig.drive.state(), DriveState::idle) << "progress step " << rig.progress().first
