@@ -123,8 +123,16 @@ void Drive<T>::plan_commissioning() noexcept {
     bank_.answer(ParameterStatus::not_set);
     return;
   }
-  identifier_.emplace(plan_identification(*nameplate, config_.i_max_A,
-                                          double(bank_.access().value), config_.sample_period_s));
+  const double v_bus_V = double(bank_.access().value);
+  const bool rotate = bank_.access().field == 1;
+  std::optional<InertiaPlan> rotating;
+  if (rotate) {
+    rotating = plan_inertia_test(*nameplate, config_.i_max_A, v_bus_V, config_.sample_period_s,
+                                 board_.encoder_counts_per_rev);
+  }
+  identifier_.emplace(
+      plan_identification(*nameplate, config_.i_max_A, v_bus_V, config_.sample_period_s),
+      rotating);
   bank_.answer(ParameterStatus::ok);
 }
 
@@ -132,7 +140,8 @@ template <typename T>
 void Drive<T>::adopt_commissioning() noexcept {
   // The tick let go of the model when it asked; the identifier has finished.
   const control::MotorParameters motor =
-      commissioned_motor(identifier_->result(), *bank_.nameplate(), bank_.record());
+      commissioned_motor(identifier_->electrical(), *bank_.nameplate(), bank_.record(),
+                         identifier_->mechanics());
   const ParameterStatus status = bank_.adopt(motor, hw_.store);
   model_.reset();
   if (const auto record = bank_.record()) {  // the new motor, or the old one if refused
@@ -146,12 +155,12 @@ template <typename T>
 Modulation<T> Drive<T>::identify(const Measurement<T>& m) noexcept {
   Modulation<T> out;
   if (!m.valid || !identifier_) return out;
-  out.u_alphabeta_V = identifier_->step(m.i_alphabeta_A);
+  out.u_alphabeta_V = identifier_->step(m.i_alphabeta_A, m.encoder_delta_counts);
   const control::SvpwmResult<T> pwm = control::svpwm(out.u_alphabeta_V, m.v_bus_V);
   for (int phase = 0; phase < 3; ++phase) out.duty[phase] = static_cast<float>(pwm.duty[phase]);
   out.clipped = pwm.clipped;
   out.finite = std::isfinite(out.u_alphabeta_V.x()) && std::isfinite(out.u_alphabeta_V.y());
-  supervisor_.identification_progress(static_cast<uint8_t>(identifier_->current_step()),
+  supervisor_.identification_progress(identifier_->step_code(),
                                       static_cast<float>(identifier_->fraction()));
   return out;
 }
@@ -166,8 +175,8 @@ void Drive<T>::end_identification(uint64_t k) noexcept {
       !identifier_->finished()) {
     return;
   }
-  const bool done = identifier_->current_step() == IdentificationStep::done;
-  supervisor_.identification_ended(k, done, static_cast<uint8_t>(identifier_->failure()));
+  const bool done = identifier_->succeeded();
+  supervisor_.identification_ended(k, done, identifier_->failure_code());
   pwm_off();
   if (!done) return;
   // The new record replaces the model: the service loop builds it from the result.

@@ -17,7 +17,7 @@
 #include "firmware/drive_config.hpp"
 #include "firmware/drive_state.hpp"
 #include "firmware/execution_stats.hpp"
-#include "firmware/identification/standstill_identifier.hpp"
+#include "firmware/identification/commissioning.hpp"
 #include "firmware/laws/law_registry.hpp"
 #include "firmware/motor_model.hpp"
 #include "firmware/parameters/parameter_bank.hpp"
@@ -150,7 +150,7 @@ class Drive final : public hal::TickHandler {
   std::atomic<bool> model_ready_;  ///< model_ is whole: set by service, cleared by the tick
   MotorModel<T>* attached_;        ///< tick side: the model in use, null while none
   /// Planned by the service loop on an identify command, then run by the tick.
-  std::optional<StandstillIdentifier<T>> identifier_;
+  std::optional<Commissioning<T>> identifier_;
   bool adopt_pending_ = false;  ///< its result still waits for the bank (tick side)
   Protection<T> protection_;
   Telemetry telemetry_;

@@ -18,7 +18,7 @@ enum class DriveState : uint8_t {
   /// PWM off, enable refused: no valid motor record yet, or the one just written is being
   /// applied (the model is rebuilt outside the tick)
   unconfigured,
-  identifying,  ///< the standstill commissioning drives the motor (no torque)
+  identifying,  ///< the commissioning drives the motor (at standstill, then turning if let)
 };
 inline constexpr int kDriveStateCount = 8;
 

@@ -33,7 +33,7 @@ enum class Mode : uint8_t {
   off,          ///< the PWM is off (calibrating, idle, fault)
   magnetizing,  ///< the magnetizing current
   controlling,  ///< the selected law (running or stopping)
-  identifying,  ///< the standstill commissioning drives the motor
+  identifying,  ///< the commissioning drives the motor
 };
 
 template <typename T>

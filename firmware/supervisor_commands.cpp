@@ -121,7 +121,11 @@ protocol::CommandResult Supervisor<T>::apply(const protocol::Command& c, uint64_
       if (!at_rest || !enable_input_ || wiring_.parameters == nullptr) {
         return CommandResult::not_allowed;
       }
-      const ParameterAccess request{protocol::ParameterOp::identify, 0, float(v_bus_V_), true};
+      // The access carries the bus voltage the test is planned on, and in its field whether
+      // the rotor may turn.
+      const ParameterAccess request{protocol::ParameterOp::identify,
+                                    static_cast<uint8_t>(c.value == 1.0f ? 1 : 0),
+                                    float(v_bus_V_), true};
       return wiring_.parameters->submit(request) ? CommandResult::accepted
                                                  : CommandResult::not_allowed;
     }

@@ -96,6 +96,8 @@ Decoded CommandDecoder::decode(const hal::CanFrame& frame) noexcept {
       break;
     case MessageId::identify:
       c.kind = CommandKind::identify;
+      c.value = get_physical(frame.data, payload_signal(MessageId::identify));
+      if (c.value != 0.0f && c.value != 1.0f) return reject(d, CommandResult::out_of_range);
       break;
     case MessageId::set_speed:
       c.kind = CommandKind::set_speed;

@@ -123,11 +123,13 @@ inline constexpr ValueName kParameterOpValues[] = {{0, "read"}, {1, "write"}, {2
 inline constexpr ValueName kIdentifyStepValues[] = {
     {0, "low_level"}, {1, "high_level"}, {2, "transient_inductance"},
     {3, "ramp_down"}, {4, "done"},       {5, "failed"},
-    {6, "none"},
+    {6, "none"},      {7, "flux_up"},    {8, "accelerate"},
+    {9, "coast"},     {10, "brake"},     {11, "field_down"},
 };
 inline constexpr ValueName kIdentifyFailureValues[] = {
     {0, "none"},        {1, "not_settled"}, {2, "voltage_limit"}, {3, "implausible"},
     {4, "no_nameplate"}, {5, "aborted"},    {6, "invalid_record"},
+    {7, "no_motion"},  // done: the rotor did not turn, the mechanics were kept
 };
 inline constexpr ValueName kParameterStatusValues[] = {
     {0, "ok"},         {1, "not_idle"},  {2, "unknown_field"}, {3, "not_finite"},
@@ -169,6 +171,14 @@ inline constexpr Signal kSetFluxSignals[] = {
     kE2eCounter,
     {"flux2_ref_Wb2", 16, 32, false, 1, 1000000, 0.0f, "Wb^2",
      "squared flux reference: rotor flux (dsmc) or stator flux (iol)"}};
+inline constexpr ValueName kIdentifyRotateValues[] = {{0, "standstill"}, {1, "rotate"}};
+inline constexpr Signal kIdentifySignals[] = {
+    kE2eCrc,
+    kE2eCounter,
+    {"rotate", 16, 8, false, 1, 1, 0.0f, "",
+     "1: after the standstill steps, turn the motor to measure inertia and friction (the shaft "
+     "must be free to turn); 0: standstill only, the mechanics are kept",
+     kIdentifyRotateValues}};
 inline constexpr Signal kSelectControllerSignals[] = {
     kE2eCrc,
     kE2eCounter,
@@ -287,10 +297,9 @@ inline constexpr Message kMessages[] = {
     {MessageId::parameter_value, "parameter_value", 7, Direction::drive_to_host, Timing::on_event,
      0, "the answer to every parameter_access: the value or why it was refused",
      kParameterValueSignals},
-    {MessageId::identify, "identify", 2, Direction::host_to_drive, Timing::on_event, 0,
-     "start the standstill commissioning from the nameplate (idle or unconfigured); disable "
-     "aborts it",
-     kEmptyCommandSignals},
+    {MessageId::identify, "identify", 3, Direction::host_to_drive, Timing::on_event, 0,
+     "start the commissioning from the nameplate (idle or unconfigured); disable aborts it",
+     kIdentifySignals},
     {MessageId::identify_progress, "identify_progress", 5, Direction::drive_to_host,
      Timing::cyclic, 100, "the commissioning's step and progress at 10 Hz while it runs, and "
      "its end", kIdentifyProgressSignals},

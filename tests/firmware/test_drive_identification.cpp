@@ -1,6 +1,7 @@
 // The commissioning as a drive mode, over CAN on the simulated board: a drive without a motor
 // record is given a nameplate, identifies the motor at standstill, stores the record and runs
-// on it; a disable aborts the run; a run without a nameplate fails with its reason.
+// on it; allowed to turn the rotor, it measures the inertia and friction too; a disable aborts
+// the run; a run without a nameplate fails with its reason.
 #include <gtest/gtest.h>
 
 #include <array>
@@ -157,6 +158,34 @@ TEST(DriveIdentification, AnUnknownMotorIsIdentifiedStoredAndRun) {
   // the inertia placeholder (the catalogue rule, not measured) costs, and is far from the
   // 50 rad/s of a drive that does not run.
   EXPECT_NEAR(rig.board.plant().state().omega_mech_rad_s, 50.0, 2.0);
+}
+
+TEST(DriveIdentification, AllowedToTurnItMeasuresTheMechanicsToo) {
+  IdentifyRig rig;
+  rig.run(300);
+  rig.nameplate();
+  rig.send({CommandKind::identify, 1.0f});  // rotate
+  rig.run(3);
+  ASSERT_EQ(rig.drive.state(), DriveState::identifying);
+  bool accelerated = false;  // the progress frames went through the rotating step
+  for (int ticks = 0; rig.drive.state() == DriveState::identifying && ticks < 300'000;
+       ticks += 100) {
+    rig.run(100);
+    accelerated = accelerated || rig.progress().first == 8;  // accelerate
+  }
+  rig.run(1003);
+  ASSERT_EQ(rig.drive.state(), DriveState::idle) << "progress step " << rig.progress().first
+                                                 << ", failure " << rig.progress().second;
+  EXPECT_TRUE(accelerated);
+  EXPECT_EQ(rig.progress(), std::make_pair(4, 0));  // done, no failure
+  const control::MotorParameters& truth = small_motor();
+  const control::MotorParameters m = *rig.drive.motor();
+  // The bound of docs/identification.md for J; the friction's of test_inertia_identification.cpp:
+  // 10 % of B plus 1 % of the test torque over the test speed (0.43 N m at 47 rad/s here).
+  EXPECT_LT(relative_error(m.J_kgm2, truth.J_kgm2), 0.10);
+  EXPECT_NEAR(m.friction_Nms, truth.friction_Nms, 0.1 * truth.friction_Nms + 0.01 * 0.43 / 47.1);
+  EXPECT_GT(rig.theta_max_rad, 2.0 * std::numbers::pi);  // it did turn
+  EXPECT_LT(std::abs(rig.board.plant().state().omega_mech_rad_s), 2.0);  // and was braked
 }
 
 TEST(DriveIdentification, ADisableAbortsTheRunWithThePwmOff) {
