@@ -121,13 +121,34 @@ void read_load_like(Reader& r, const std::string& prefix, LoadProfile& p) {
   }
 }
 
-/// The simulated motor: [motor] with the keys [plant] changes (any motor key, nothing else).
-control::MotorParameters parse_plant_table(const toml::table& doc, const std::string& source) {
+/// The [motor] table of the motor file `file` names (relative to the scenario's directory).
+toml::table motor_table_of(const std::filesystem::path& scenario, const toml::node& file,
+                           const std::string& key) {
+  const auto* name = file.as_string();
+  if (name == nullptr) {
+    throw ConfigError(fmt::format("{}: {} must be a string", scenario.string(), key));
+  }
+  const std::filesystem::path motor_path = scenario.parent_path() / name->get();
+  const toml::table motor_doc = parse_toml_file(motor_path);
+  const toml::node* motor = motor_doc.get("motor");
+  if (motor == nullptr || !motor->is_table()) {
+    throw ConfigError(fmt::format("{}: missing table [motor]", motor_path.string()));
+  }
+  return *motor->as_table();
+}
+
+/// The simulated motor: [plant] motor_file, or else [motor], with the keys [plant] changes (any
+/// motor key, nothing else). `base`: the plant's motor when it is not [motor].
+control::MotorParameters parse_plant_table(const toml::table& doc, const std::string& source,
+                                           const std::optional<toml::table>& base) {
   const toml::node* plant = doc.get("plant");
-  if (plant == nullptr) return parse_motor_table(doc, source);
-  if (!plant->is_table()) throw ConfigError(fmt::format("{}: plant must be a table", source));
-  toml::table completed = *doc.get("motor")->as_table();  // parse_motor_table checked it
-  for (auto&& [key, value] : *plant->as_table()) {
+  if (plant == nullptr && !base) return parse_motor_table(doc, source);
+  if (plant != nullptr && !plant->is_table()) {
+    throw ConfigError(fmt::format("{}: plant must be a table", source));
+  }
+  toml::table completed = base ? *base : *doc.get("motor")->as_table();  // checked
+  const toml::table changes = plant != nullptr ? *plant->as_table() : toml::table{};
+  for (auto&& [key, value] : changes) {
     if (!kMotorKeys.count(std::string(key.str())) && key.str() != "name") {
       throw ConfigError(fmt::format("{}: unknown key plant.{} (a motor key: Rs_Ohm, Ls_H, Lm_H, "
                                     "Rr_Ohm, Lr_H, J_kgm2, pole_pairs, friction_Nms)",
@@ -143,30 +164,41 @@ control::MotorParameters parse_plant_table(const toml::table& doc, const std::st
 }  // namespace
 
 Scenario load_scenario(const std::filesystem::path& path,
-                       const std::vector<std::string>& overrides) {
+                       const std::vector<std::string>& overrides,
+                       const std::optional<std::filesystem::path>& model_file) {
   toml::table doc = parse_toml_file(path);
   const std::string source = path.string();
   if (const toml::node* motor_file = doc.get("motor_file")) {
     if (doc.get("motor") != nullptr) {
       throw ConfigError(fmt::format("{}: give either motor_file or [motor], not both", source));
     }
-    const auto* name = motor_file->as_string();
-    if (name == nullptr) throw ConfigError(fmt::format("{}: motor_file must be a string", source));
-    const std::filesystem::path motor_path = path.parent_path() / name->get();
-    const toml::table motor_doc = parse_toml_file(motor_path);
-    const toml::node* motor = motor_doc.get("motor");
-    if (motor == nullptr || !motor->is_table()) {
-      throw ConfigError(fmt::format("{}: missing table [motor]", motor_path.string()));
-    }
-    doc.insert("motor", *motor->as_table());
+    doc.insert("motor", motor_table_of(path, *motor_file, "motor_file"));
     doc.erase("motor_file");
   }
   for (const std::string& assignment : overrides) apply_override(doc, assignment, source);
+  // [plant] motor_file: the simulated motor starts from that file instead of [motor].
+  std::optional<toml::table> plant_base;
+  if (toml::table* plant = doc["plant"].as_table()) {
+    if (const toml::node* file = plant->get("motor_file")) {
+      plant_base = motor_table_of(path, *file, "plant.motor_file");
+      plant->erase("motor_file");
+    }
+  }
+  if (model_file) {  // the controller's motor from the file; the plant stays the scenario's
+    if (!plant_base && doc.get("motor") != nullptr) plant_base = *doc.get("motor")->as_table();
+    const toml::table model_doc = parse_toml_file(*model_file);
+    (void)parse_motor_table(model_doc, model_file->string());  // its own errors, its own name
+    doc.insert_or_assign("motor", *model_doc.get("motor")->as_table());
+  }
+  // A commissioning run gives the drive no motor: without [motor], the plant's stands for it.
+  if (doc.get("motor") == nullptr && plant_base && doc.get("nameplate") != nullptr) {
+    doc.insert("motor", *plant_base);
+  }
 
   Scenario s;
   s.source = source;
   s.motor = parse_motor_table(doc, source);
-  s.plant = parse_plant_table(doc, source);
+  s.plant = parse_plant_table(doc, source, plant_base);
   Reader r(doc, source);
   r.accept_table("motor");
   r.accept_table("plant");
@@ -303,6 +335,7 @@ Scenario load_scenario(const std::filesystem::path& path,
   detail::read_protection(r, s);
   detail::read_faults(r, s);
   detail::read_can_commands(r, s);
+  detail::read_commissioning(r, s);
   r.reject_unknown();
   return s;
 }

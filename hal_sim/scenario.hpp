@@ -52,6 +52,17 @@ struct ProtectionSettings {
   std::optional<double> stop_decel_rad_s2;  ///< deceleration of the stop on a disable command
 };
 
+/// [nameplate] and [identify]: a commissioning run (docs/scenarios.md). The drive starts with an
+/// empty parameter store, as a new board does; the runner writes the nameplate over CAN at
+/// start_s (1 ms apart) and sends the identify command after it. The run ends when the
+/// commissioning has ended.
+struct CommissioningSettings {
+  double rated_voltage_V = 0.0, rated_current_A = 0.0, rated_frequency_Hz = 0.0;
+  int pole_pairs = 0;
+  bool rotate = true;    ///< the rotating step for inertia and friction
+  double start_s = 0.1;  ///< after the ADC calibration
+};
+
 /// The laws a scenario may name in drive.controller: the drive's laws by the CAN protocol's
 /// names (firmware/protocol/messages.hpp; the simulator's core does not depend on the firmware,
 /// so a test checks that the two lists agree).
@@ -130,12 +141,16 @@ struct Scenario {
   ProtectionSettings protection;               ///< [protection]
   std::vector<FaultInjection> faults;          ///< [[faults]], sorted by at_s (stable)
   std::vector<CanCommandScript> can_commands;  ///< [[can_commands]], in file order
+  std::optional<CommissioningSettings> commissioning;  ///< [nameplate], [identify]
 };
 
 /// Loads a scenario. `overrides` are "table.key=VALUE" strings (VALUE in TOML syntax; a bare
-/// word is taken as a string), applied after any motor_file has been merged in. Throws
-/// ConfigError naming the file, the key and the value.
+/// word is taken as a string), applied after any motor_file has been merged in. `model_file`:
+/// a motor file the controller is given instead of the scenario's motor, which stays the
+/// simulated one (an identified motor on the true plant). Throws ConfigError naming the file,
+/// the key and the value.
 Scenario load_scenario(const std::filesystem::path& path,
-                       const std::vector<std::string>& overrides = {});
+                       const std::vector<std::string>& overrides = {},
+                       const std::optional<std::filesystem::path>& model_file = std::nullopt);
 
 }  // namespace imd::sim

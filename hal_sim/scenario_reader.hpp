@@ -204,5 +204,8 @@ void read_faults(Reader& r, Scenario& s);        ///< [[faults]] (after inverter
 void read_can_commands(Reader& r, Scenario& s);  ///< [[can_commands]]
 void read_can(Reader& r, Scenario& s);           ///< [can]
 void read_protection(Reader& r, Scenario& s);    ///< [protection]
+/// [nameplate], [identify]: appends the nameplate writes and the identify command to
+/// s.can_commands.
+void read_commissioning(Reader& r, Scenario& s);
 
 }  // namespace imd::sim::detail

@@ -27,8 +27,8 @@ InertiaIdentifier<T>::InertiaIdentifier(const InertiaPlan& plan,
   const T i_limit_A = T(plan.i_limit_A);
   i_d_A_ = std::min(T(plan.v_phase_peak_V) / (T(plan.omega_rated_rad_s) * motor.Ls_H),
                     T(0.7) * i_limit_A);
-  const T omega_e_test = std::min(T(0.3) * T(plan.omega_rated_rad_s),
-                                  T(0.5) * v_limit_V_ / (motor.Ls_H * i_d_A_));
+  const T omega_e_test =
+      std::min(T(0.3) * T(plan.omega_rated_rad_s), T(0.5) * v_limit_V_ / (motor.Ls_H * i_d_A_));
   omega_test_rad_s_ = omega_e_test / pole_pairs_;
   k_torque_Nm_per_A_ = T(1.5) * pole_pairs_ * Lm2_over_Lr_H_ * i_d_A_;
   const T i_free_A = std::sqrt(std::max(T(0), i_limit_A * i_limit_A - i_d_A_ * i_d_A_));
@@ -64,16 +64,17 @@ template <typename T>
 void InertiaIdentifier<T>::solve() noexcept {
   // J theta_i + B Theta_i = Y_i, i = end of acceleration, end of coast.
   const T det = row_theta_[0] * row_int_theta_[1] - row_theta_[1] * row_int_theta_[0];
-  const T J = (row_int2_torque_[0] * row_int_theta_[1] - row_int2_torque_[1] * row_int_theta_[0]) /
-              det;
+  const T J =
+      (row_int2_torque_[0] * row_int_theta_[1] - row_int2_torque_[1] * row_int_theta_[0]) / det;
   const T B = (row_theta_[0] * row_int2_torque_[1] - row_theta_[1] * row_int2_torque_[0]) / det;
   result_ = {J, B};
   stop(J > T(0) && std::isfinite(J) && std::isfinite(B) ? InertiaOutcome::measured
-                                                          : InertiaOutcome::implausible);
+                                                        : InertiaOutcome::implausible);
 }
 
 template <typename T>
-control::Vec2<T> InertiaIdentifier<T>::step(const Vec2& i_A, int32_t encoder_delta_counts) noexcept {
+control::Vec2<T> InertiaIdentifier<T>::step(const Vec2& i_A,
+                                            int32_t encoder_delta_counts) noexcept {
   ++ticks_;
   ++ticks_in_[int(step_)];
   if (finished()) return Vec2::Zero();
@@ -83,7 +84,8 @@ control::Vec2<T> InertiaIdentifier<T>::step(const Vec2& i_A, int32_t encoder_del
   const auto frame = control::Rotation<T>::from_angle(theta_e_rad_);
   const Vec2 i_dq_A = frame.apply_inverse(i_A);
   // The current model of the rotor flux, as lambda = Lm/Lr psi_r: the torque is 1.5 p lambda iq.
-  lambda_Wb_ = Lm2_over_Lr_H_ * i_dq_A.x() + flux_decay_ * (lambda_Wb_ - Lm2_over_Lr_H_ * i_dq_A.x());
+  lambda_Wb_ =
+      Lm2_over_Lr_H_ * i_dq_A.x() + flux_decay_ * (lambda_Wb_ - Lm2_over_Lr_H_ * i_dq_A.x());
   const T torque_Nm = T(1.5) * pole_pairs_ * lambda_Wb_ * i_dq_A.y();
   slip_rad_s_ = lambda_Wb_ > T(0.05) * Lm2_over_Lr_H_ * i_d_A_
                     ? Lm2_over_Lr_H_ * i_dq_A.y() / (tau_r_s_ * lambda_Wb_)
@@ -123,9 +125,9 @@ control::Vec2<T> InertiaIdentifier<T>::step(const Vec2& i_A, int32_t encoder_del
         }
       } else {
         // As long as the acceleration took (at least 0.1 s); shorter if friction stops it.
-        const uint32_t coast_ticks = std::min(
-            std::max(accelerate_ticks_, static_cast<uint32_t>(T(0.1) / period_s_)),
-            max_coast_ticks_);
+        const uint32_t coast_ticks =
+            std::min(std::max(accelerate_ticks_, static_cast<uint32_t>(T(0.1) / period_s_)),
+                     max_coast_ticks_);
         if (ticks_ >= coast_ticks || omega_block_rad_s_ < T(0.5) * omega_test_rad_s_) {
           take_row(1);
           solve();

@@ -31,15 +31,15 @@ enum class InertiaOutcome : uint8_t {
 /// tick; the rules are in plan_inertia_test()).
 struct InertiaPlan {
   double period_s = 1e-4;
-  double rad_per_count = 0.0;           ///< the encoder's mechanical angle per count
-  double omega_rated_rad_s = 0.0;       ///< electrical, 2 pi f_rated
-  double v_phase_peak_V = 0.0;          ///< rated phase voltage, peak
-  double i_limit_A = 0.0;               ///< the test's current magnitude limit (peak)
-  double v_limit_V = 0.0;               ///< the loop's output limit (linear SVPWM range)
-  double J_guess_kgm2 = 0.0;            ///< the inertia the torque is sized on (catalogue)
+  double rad_per_count = 0.0;      ///< the encoder's mechanical angle per count
+  double omega_rated_rad_s = 0.0;  ///< electrical, 2 pi f_rated
+  double v_phase_peak_V = 0.0;     ///< rated phase voltage, peak
+  double i_limit_A = 0.0;          ///< the test's current magnitude limit (peak)
+  double v_limit_V = 0.0;          ///< the loop's output limit (linear SVPWM range)
+  double J_guess_kgm2 = 0.0;       ///< the inertia the torque is sized on (catalogue)
   int pole_pairs = 1;
-  double accelerate_s = 1.0;            ///< planned acceleration time with J_guess
-  double max_accelerate_s = 30.0;       ///< beyond this with no motion: skipped
+  double accelerate_s = 1.0;       ///< planned acceleration time with J_guess
+  double max_accelerate_s = 30.0;  ///< beyond this with no motion: skipped
   double max_coast_s = 10.0;
   double crossover_rad_s = 2.0 * 3.14159265358979 * 200.0;  ///< current loop bandwidth
 };

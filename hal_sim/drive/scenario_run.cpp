@@ -8,6 +8,7 @@
 #include "control/current_fed_model.hpp"
 #include "control/frames.hpp"
 #include "firmware/drive.hpp"
+#include "hal_sim/drive/commissioning_watch.hpp"
 #include "hal_sim/drive/lockstep_period.hpp"
 #include "hal_sim/drive/scenario_config.hpp"
 #include "hal_sim/drive/scripted_commands.hpp"
@@ -27,7 +28,10 @@ Summary run(const Scenario& s, const RunCallbacks& callbacks) {
   sim::prepare_board(board, s);
   const sim::ScenarioReferences<T> references(s);
   const firmware::DriveConfig config = sim::drive_config(s);
-  SimulatedDrive<T> simulated(board, s.motor, config,
+  // A commissioning run starts as a new board: no record in its store.
+  const std::optional<firmware::MotorRecord> record =
+      s.commissioning ? std::nullopt : std::optional<firmware::MotorRecord>(s.motor);
+  SimulatedDrive<T> simulated(board, record, config,
                               {s.ideal_sensors, s.inner_feedback, s.current_fed}, &references,
                               board.timer(), &board.can());
   firmware::Drive<T>& drive = simulated.drive();
@@ -45,6 +49,7 @@ Summary run(const Scenario& s, const RunCallbacks& callbacks) {
   TickObserver<T> observer(observed_run(profiles(s), s.settle_s, s.motor, config));
   FaultSchedule faults(s.faults.data(), s.faults.size());
   std::vector<hal::CanFrame> sent_frames;  // reused: no allocation per tick
+  CommissioningWatch commissioning(s.sample_period_s);
   uint16_t last_fault_bits = 0;
   bool diverged = false;
   for (uint64_t k = 0; k < ticks; ++k) {
@@ -103,6 +108,10 @@ Summary run(const Scenario& s, const RunCallbacks& callbacks) {
       awaiting_pwm_off.clear();
     }
     if (callbacks.row) callbacks.row(row);
+    if (s.commissioning && commissioning.after_tick(drive)) {  // its end ends the run
+      summary.ticks = k + 1;
+      break;
+    }
     if (callbacks.progress && (k & 1023) == 0) {
       const auto now = std::chrono::steady_clock::now();
       if (now - last_progress > std::chrono::seconds(1)) {
@@ -111,7 +120,8 @@ Summary run(const Scenario& s, const RunCallbacks& callbacks) {
       }
     }
   }
-  if (!diverged) summary.ticks = ticks;
+  if (!diverged && !commissioning.report().ended) summary.ticks = ticks;
+  if (s.commissioning) summary.commissioning = commissioning.report();
   summary.simulated_s = double(summary.ticks) * s.sample_period_s;
   summary.wall_time_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();

@@ -4,11 +4,13 @@
 #include <cmath>
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include "hal/can_bus.hpp"
+#include "hal_sim/drive/commissioning_watch.hpp"
 #include "hal_sim/drive/tick_observer.hpp"
 #include "hal_sim/scenario.hpp"
 
@@ -41,6 +43,8 @@ struct Summary {
   double stage_ns_mean[firmware::kStageCount] = {};
   double running_from_s = -1.0;  ///< first time the drive was running (-1: never)
   std::vector<FaultEvent> faults;
+  /// A commissioning scenario's report (the run ends with the commissioning).
+  std::optional<CommissioningReport> commissioning;
 };
 
 struct RunCallbacks {

@@ -31,9 +31,10 @@ struct Rig final : hal::TickHandler {
   BoardSensing<T> sensing;
   Commissioning<T> commissioning;
 
-  Rig(const control::MotorParameters& m, const sim::SimBoardConfig& b,
-      const IdentificationPlan& p, const InertiaPlan& ip)
-      : board(m, b), sensing(board.adc(), board.encoder(), {256, 0.5 * b.adc.full_scale_A}),
+  Rig(const control::MotorParameters& m, const sim::SimBoardConfig& b, const IdentificationPlan& p,
+      const InertiaPlan& ip)
+      : board(m, b),
+        sensing(board.adc(), board.encoder(), {256, 0.5 * b.adc.full_scale_A}),
         commissioning(p, ip) {
     board.timer().start(*this);
   }
@@ -96,13 +97,14 @@ void identify_and_check(const Case& c, const char* precision) {
   const InertiaIdentifier<T>& r = *rig.commissioning.rotating();
   const double J = double(mechanics->J_kgm2), B = double(mechanics->friction_Nms);
   const double test_speed = double(r.test_speed_rad_s()), torque = double(r.torque_Nm());
-  std::printf("%s (%s): J %.4g kg m^2 (true %.4g, %.2f %%), B %.3g N m s (true %.3g); test "
-              "%.1f rad/s at %.3g N m; simulated s: flux up %.2f, accelerate %.2f, coast %.2f, "
-              "brake %.2f, field down %.2f\n",
-              c.motor, precision, J, truth.J_kgm2, 100 * std::abs(J / truth.J_kgm2 - 1), B,
-              truth.friction_Nms, test_speed, torque, r.ticks_in(InertiaStep::flux_up) * 1e-4,
-              r.ticks_in(InertiaStep::accelerate) * 1e-4, r.ticks_in(InertiaStep::coast) * 1e-4,
-              r.ticks_in(InertiaStep::brake) * 1e-4, r.ticks_in(InertiaStep::ramp_down) * 1e-4);
+  std::printf(
+      "%s (%s): J %.4g kg m^2 (true %.4g, %.2f %%), B %.3g N m s (true %.3g); test "
+      "%.1f rad/s at %.3g N m; simulated s: flux up %.2f, accelerate %.2f, coast %.2f, "
+      "brake %.2f, field down %.2f\n",
+      c.motor, precision, J, truth.J_kgm2, 100 * std::abs(J / truth.J_kgm2 - 1), B,
+      truth.friction_Nms, test_speed, torque, r.ticks_in(InertiaStep::flux_up) * 1e-4,
+      r.ticks_in(InertiaStep::accelerate) * 1e-4, r.ticks_in(InertiaStep::coast) * 1e-4,
+      r.ticks_in(InertiaStep::brake) * 1e-4, r.ticks_in(InertiaStep::ramp_down) * 1e-4);
   EXPECT_LT(std::abs(J / truth.J_kgm2 - 1), 0.10);
   EXPECT_LT(std::abs(B - truth.friction_Nms),
             0.10 * truth.friction_Nms + 0.01 * torque / test_speed);
@@ -138,8 +140,7 @@ TEST(InertiaIdentification, AShaftThatDoesNotTurnSkipsTheStep) {
   const sim::SimBoardConfig b = board_for(c);
   InertiaPlan ip = plan_inertia_test(c.nameplate, c.i_max_A, c.v_bus_V, b.period_s, b.encoder_cpr);
   ip.max_accelerate_s = 2.0;
-  Rig<double> rig(heavy, b, plan_identification(c.nameplate, c.i_max_A, c.v_bus_V, b.period_s),
-                  ip);
+  Rig<double> rig(heavy, b, plan_identification(c.nameplate, c.i_max_A, c.v_bus_V, b.period_s), ip);
   run(rig);
   EXPECT_TRUE(rig.commissioning.succeeded());
   EXPECT_EQ(rig.commissioning.failure_code(), 7);  // no_motion

@@ -2,9 +2,11 @@
 //
 //   drive_sim SCENARIO.toml [--duration-s S] [--csv PATH] [--summary-json PATH]
 //             [--plot PATH.png] [--can-log PATH] [--set table.key=VALUE]...
+//             [--motor-file PATH] [--motor-out PATH]
 //
 // Prints the summary (JSON) on standard output. Exit codes: 0 success, 2 bad input (command
-// line or scenario file), 1 an output could not be written.
+// line or scenario file), 1 an output could not be written, 3 a commissioning run identified
+// no motor (the summary says why).
 #include <fmt/format.h>
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
@@ -27,6 +29,7 @@
 extern char** environ;
 
 #include "hal_sim/config_error.hpp"
+#include "hal_sim/motor_file.hpp"
 #include "hal_sim/scenario.hpp"
 #include "tools/can_log/candump_log.hpp"
 #include "hal_sim/drive/scenario_run.hpp"
@@ -36,6 +39,7 @@ namespace {
 
 constexpr int kExitBadInput = 2;
 constexpr int kExitOutputFailed = 1;
+constexpr int kExitNotIdentified = 3;
 
 /// The CSV columns (docs/scenarios.md): one table for the header and the rows.
 struct Column {
@@ -95,6 +99,26 @@ nlohmann::ordered_json motor_json(const imd::control::MotorParameters& m) {
           {"pole_pairs", m.pole_pairs}, {"friction_Nms", m.friction_Nms}};
 }
 
+/// A commissioning run's report: "identified" (the record's keys, and the quantities the
+/// terminals determine) and "identification" (how it ended, the time of each step).
+void commissioning_json(const imd::sim::CommissioningReport& c, nlohmann::ordered_json& out) {
+  nlohmann::ordered_json steps = nlohmann::ordered_json::object();
+  for (const auto& [name, seconds] : c.step_s) steps[name] = seconds;
+  out["identification"] = {{"ended", c.ended},    {"result", c.step},
+                           {"failure", c.failure}, {"steps_s", steps},
+                           {"total_s", c.total_s}};
+  if (!c.identified) {
+    out["identified"] = nullptr;
+    return;
+  }
+  const imd::control::MotorParameters& m = *c.identified;
+  nlohmann::ordered_json identified = motor_json(m);
+  identified["sigma_Ls_H"] = m.Ls_H - m.Lm_H * m.Lm_H / m.Lr_H;
+  identified["tau_r_s"] = m.Lr_H / m.Rr_Ohm;
+  identified["Lm2_over_Lr_H"] = m.Lm_H * m.Lm_H / m.Lr_H;
+  out["identified"] = identified;
+}
+
 nlohmann::ordered_json summary_json(const imd::sim::Scenario& s, const imd::sim::Summary& r) {
   nlohmann::ordered_json faults = nlohmann::ordered_json::array();
   auto time = [](double t_s) {  // NaN: it did not happen
@@ -112,7 +136,7 @@ nlohmann::ordered_json summary_json(const imd::sim::Scenario& s, const imd::sim:
   for (int i = 0; i < imd::firmware::kStageCount; ++i) {
     stages[imd::firmware::kStageNames[i]] = r.stage_ns_mean[i];
   }
-  return {{"scenario", s.source},
+  nlohmann::ordered_json result = {{"scenario", s.source},
           {"controller", s.controller},
           {"precision", s.precision},
           {"motor", motor_json(s.motor)},  // what the controller was given
@@ -139,6 +163,8 @@ nlohmann::ordered_json summary_json(const imd::sim::Scenario& s, const imd::sim:
           {"tick_exec_ns_max", r.tick_exec_ns_max},
           {"stage_ns", stages},
           {"faults", faults}};
+  if (r.commissioning) commissioning_json(*r.commissioning, result);
+  return result;
 }
 
 /// The plot script for the scenario's controller: paper 000's figures or paper 001's.
@@ -163,7 +189,8 @@ int run_program(std::vector<std::string> args) {
 
 int main(int argc, char** argv) {
   CLI::App app{"Runs the drive firmware on the simulated board for a scenario file."};
-  std::string scenario_path, csv_path, summary_path, plot_path, can_log_path;
+  std::string scenario_path, csv_path, summary_path, plot_path, can_log_path, motor_out_path;
+  std::optional<std::string> model_file;
   std::optional<double> duration_s;
   std::vector<std::string> overrides;
   app.add_option("scenario", scenario_path, "Scenario file (TOML)")->required();
@@ -177,6 +204,14 @@ int main(int argc, char** argv) {
                  "Write every CAN frame the firmware sent to this file (candump -L format, "
                  "interface can0, simulated time)");
   app.add_option("--set", overrides, "Override a scenario key: table.key=VALUE (repeatable)");
+  app.add_option("--motor-file", model_file,
+                 "Give the controller this motor file instead of the scenario's motor; the "
+                 "simulated motor stays the scenario's (e.g. an identified motor on the true "
+                 "plant)")
+      ->check(CLI::ExistingFile);
+  app.add_option("--motor-out", motor_out_path,
+                 "A commissioning scenario ([nameplate]): write the identified motor to this "
+                 "motor file");
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& error) {
@@ -187,7 +222,13 @@ int main(int argc, char** argv) {
 
   imd::sim::Scenario scenario;
   try {
-    scenario = imd::sim::load_scenario(scenario_path, overrides);
+    scenario = imd::sim::load_scenario(scenario_path, overrides,
+                                       model_file ? std::optional<std::filesystem::path>(*model_file)
+                                                  : std::nullopt);
+    if (!motor_out_path.empty() && !scenario.commissioning) {
+      throw imd::sim::ConfigError(scenario_path +
+                                  ": --motor-out needs a commissioning scenario ([nameplate])");
+    }
     imd::sim::scripted_frames(scenario);  // [[can_commands]] against the protocol table
   } catch (const imd::sim::ConfigError& error) {
     std::cerr << "drive_sim: " << error.what() << '\n';
@@ -268,6 +309,30 @@ int main(int argc, char** argv) {
       std::cerr << "drive_sim: cannot write " << summary_path << '\n';
       return kExitOutputFailed;
     }
+  }
+  if (!motor_out_path.empty()) {
+    const auto& c = summary.commissioning;
+    if (!c || !c->identified) {
+      std::cerr << "drive_sim: no motor identified (" << (c ? c->failure : "not run")
+                << "): " << motor_out_path << " not written\n";
+      return kExitNotIdentified;
+    }
+    const std::string motor_text = imd::sim::motor_file_text(
+        *c->identified, "identified by commissioning",
+        fmt::format("Identified by drive_sim {} (nameplate {} V, {} A, {} Hz, {} pole pairs).\n"
+                    "Lr = Ls by the convention of equal leakages (docs/identification.md).",
+                    scenario.source, scenario.commissioning->rated_voltage_V,
+                    scenario.commissioning->rated_current_A,
+                    scenario.commissioning->rated_frequency_Hz,
+                    scenario.commissioning->pole_pairs));
+    std::FILE* file = std::fopen(motor_out_path.c_str(), "w");
+    if (file == nullptr || std::fputs(motor_text.c_str(), file) < 0 || std::fclose(file) != 0) {
+      std::cerr << "drive_sim: cannot write " << motor_out_path << '\n';
+      return kExitOutputFailed;
+    }
+  }
+  if (scenario.commissioning && !(summary.commissioning && summary.commissioning->identified)) {
+    return kExitNotIdentified;
   }
   if (!plot_path.empty()) {
     const int status = run_program({"/usr/bin/python3", plot_script(scenario), csv_path, "--out",
