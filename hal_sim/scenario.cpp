@@ -247,6 +247,10 @@ Scenario load_scenario(const std::filesystem::path& path,
   // The speed reference drives the DSMC and the iol's outer speed loop; the iol without it
   // follows a torque reference.
   // With command_source = "can" it comes only from CAN commands.
+  if (r.present("nameplate") && s.command_source != "can") {
+    r.fail("drive.command_source", "a commissioning run ([nameplate]) needs command_source = "
+                                   "\"can\": the nameplate and the identify command go over CAN");
+  }
   if (s.command_source == "can") {
     if (r.present("reference.speed")) {
       r.fail("reference.speed",
