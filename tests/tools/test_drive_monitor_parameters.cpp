@@ -72,3 +72,36 @@ TEST(drive_monitor_parameters, TheCommandCarriesOpFieldAndValue) {
 
 }  // namespace
 }  // namespace imd::monitor
+
+namespace imd::monitor {
+namespace {
+
+namespace protocol = firmware::protocol;
+
+hal::CanFrame progress_frame(uint8_t node, float step, float fraction, float failure, float s) {
+  return protocol::encode_frame(node, protocol::MessageId::identify_progress,
+                                {step, fraction, failure, s});
+}
+
+TEST(drive_monitor_identify, DecodesAndShowsTheProgress) {
+  const auto p = decode_identify_progress(progress_frame(2, 8.0f, 0.4f, 0.0f, 12.3f), 2);
+  ASSERT_TRUE(p.has_value());
+  EXPECT_TRUE(p->running());
+  EXPECT_FALSE(p->ended());
+  EXPECT_EQ(progress_text(*p), "accelerate 40 % (12.3 s)");
+  EXPECT_FALSE(decode_identify_progress(progress_frame(2, 8.0f, 0.4f, 0.0f, 1.0f), 3));
+  const auto done = decode_identify_progress(progress_frame(2, 4.0f, 1.0f, 0.0f, 16.4f), 2);
+  EXPECT_TRUE(done->ended());
+  EXPECT_EQ(progress_text(*done), "done (16.4 s)");
+  // Done without turning: the reason the mechanics were kept is shown.
+  const auto kept = decode_identify_progress(progress_frame(2, 4.0f, 1.0f, 7.0f, 5.0f), 2);
+  EXPECT_EQ(progress_text(*kept), "done: no_motion (5.0 s)");
+  const auto failed = decode_identify_progress(progress_frame(2, 5.0f, 1.0f, 1.0f, 60.2f), 2);
+  EXPECT_EQ(progress_text(*failed), "failed: not_settled (60.2 s)");
+  // Before a run: "none" is neither running nor ended.
+  const auto idle = decode_identify_progress(progress_frame(2, 6.0f, 0.0f, 0.0f, 0.0f), 2);
+  EXPECT_FALSE(idle->running() || idle->ended());
+}
+
+}  // namespace
+}  // namespace imd::monitor

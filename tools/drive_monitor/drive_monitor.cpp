@@ -7,6 +7,7 @@
 //                      [--wait-ack-s S] [--repeat-hz F --for-s S]
 //   drive_monitor parameters --can IFACE --node N [--set KEY=VALUE]... [--motor-file PATH]
 //                            [--save] [--motor-out PATH] [--wait-s S] [--wait-heartbeat-s S]
+//   drive_monitor identify --can IFACE --node N [--rotate] [--motor-out PATH] [--timeout-s S]
 //
 // watch decodes node N's frames (default 1); the CSV's time_s is the log's timestamp, or with
 // --can the seconds since watch started. send learns the alive counter from the heartbeat.
@@ -26,6 +27,10 @@
 // parameters writes the given fields (each answered after the drive has checked it: a refusal
 // prints its reason and the exit code is 3), saves the record if asked, then reads every field
 // back and prints it; --motor-out writes what it read as a motor file.
+//
+// identify starts the commissioning (the drive's record must hold the nameplate), prints its
+// progress, and on success reads the identified record back as parameters does; exit code 3
+// when the drive refuses or the run fails (the reason is printed), 4 when it does not answer.
 #include <poll.h>
 #include <unistd.h>
 #include <CLI/CLI.hpp>
@@ -46,6 +51,7 @@
 #include "tools/can_log/candump_log.hpp"
 #include "tools/drive_monitor/cli_io.hpp"
 #include "tools/drive_monitor/monitor.hpp"
+#include "tools/drive_monitor/identify_cli.hpp"
 #include "tools/drive_monitor/parameters_cli.hpp"
 #include "tools/drive_monitor/repeat_send.hpp"
 #include "tools/drive_monitor/send_command.hpp"
@@ -347,6 +353,8 @@ int main(int argc, char** argv) {
 
   ParametersOptions p;
   CLI::App* parameters = add_parameters_command(app, p);
+  IdentifyOptions id;
+  CLI::App* identify = add_identify_command(app, id);
 
   try {
     app.parse(argc, argv);
@@ -359,6 +367,7 @@ int main(int argc, char** argv) {
     return w.log.empty() ? watch_live(w) : watch_log(w);
   }
   if (parameters->parsed()) return run_parameters(p);
+  if (identify->parsed()) return run_identify(id);
   if (value_option->count() > 0) s.value = value;
   if (repeat_option->count() > 0) {
     s.repeat = imd::monitor::RepeatPlan{repeat_Hz, for_s, s.wait_ack_s};

@@ -3,6 +3,8 @@
 #include <cmath>
 #include <cstdlib>
 
+#include <fmt/format.h>
+
 #include "firmware/protocol/frame_codec.hpp"
 
 namespace imd::monitor {
@@ -69,8 +71,7 @@ protocol::Command parameter_command(protocol::ParameterOp op, uint8_t field, flo
   return c;
 }
 
-std::optional<ParameterReply> decode_parameter_value(const hal::CanFrame& frame,
-                                                     uint8_t node_id) {
+std::optional<ParameterReply> decode_parameter_value(const hal::CanFrame& frame, uint8_t node_id) {
   const protocol::Message& m = protocol::message(protocol::MessageId::parameter_value);
   if (frame.id != protocol::can_id(node_id, m.id) || frame.length != m.length) return std::nullopt;
   const auto& s = m.signals;
@@ -80,6 +81,30 @@ std::optional<ParameterReply> decode_parameter_value(const hal::CanFrame& frame,
                         protocol::get_physical(frame.data, s[3]),
                         protocol::get_raw(frame.data, s[4]) != 0,
                         protocol::get_raw(frame.data, s[5]) != 0};
+}
+
+std::optional<IdentifyProgress> decode_identify_progress(const hal::CanFrame& frame,
+                                                         uint8_t node_id) {
+  const protocol::Message& m = protocol::message(protocol::MessageId::identify_progress);
+  if (frame.id != protocol::can_id(node_id, m.id) || frame.length != m.length) return std::nullopt;
+  const auto& s = m.signals;
+  return IdentifyProgress{static_cast<uint8_t>(protocol::get_raw(frame.data, s[0])),
+                          static_cast<uint8_t>(protocol::get_raw(frame.data, s[2])),
+                          protocol::get_physical(frame.data, s[1]),
+                          protocol::get_physical(frame.data, s[3])};
+}
+
+std::string progress_text(const IdentifyProgress& p) {
+  const auto& s = protocol::message(protocol::MessageId::identify_progress).signals;
+  const char* step = protocol::value_name(s[0], p.step);
+  const std::string name = step != nullptr ? step : "step " + std::to_string(p.step);
+  const std::string seconds = fmt::format(" ({:.1f} s)", p.seconds);
+  if (p.step == 5 || (p.step == 4 && p.failure != 0)) {
+    const char* why = protocol::value_name(s[2], p.failure);
+    return name + ": " + (why != nullptr ? why : std::to_string(p.failure)) + seconds;
+  }
+  if (p.ended()) return name + seconds;
+  return fmt::format("{} {:.0f} %{}", name, 100.0f * p.fraction, seconds);
 }
 
 }  // namespace imd::monitor

@@ -41,4 +41,16 @@ struct ParameterReply {
 /// The answer if `frame` is node `node_id`'s parameter_value.
 std::optional<ParameterReply> decode_parameter_value(const hal::CanFrame& frame, uint8_t node_id);
 
+struct IdentifyProgress {
+  uint8_t step, failure;
+  float fraction, seconds;
+  bool running() const noexcept { return step <= 3 || (step >= 7 && step <= 11); }
+  bool ended() const noexcept { return step == 4 || step == 5; }
+};
+/// The progress if `frame` is node `node_id`'s identify_progress.
+std::optional<IdentifyProgress> decode_identify_progress(const hal::CanFrame& frame,
+                                                         uint8_t node_id);
+/// "accelerate 40 % (12.3 s)", or "done (14.1 s)", "failed: not_settled (60.2 s)".
+std::string progress_text(const IdentifyProgress& p);
+
 }  // namespace imd::monitor

@@ -13,6 +13,7 @@
 #include "hal_sim/motor_file.hpp"
 #include "tools/drive_monitor/cli_io.hpp"
 #include "tools/drive_monitor/parameter_access.hpp"
+#include "tools/drive_monitor/parameter_session.hpp"
 #include "tools/drive_monitor/send_command.hpp"
 
 namespace imd::monitor::cli {
@@ -21,38 +22,6 @@ namespace {
 namespace protocol = firmware::protocol;
 using firmware::ParameterStatus;
 using protocol::ParameterOp;
-
-/// One conversation with the drive: each access waits for its answer, and a busy drive (still
-/// applying the last write) is asked again until the wait runs out.
-class Session {
- public:
-  Session(hal::SocketCanBus& bus, uint8_t node, uint8_t counter, double wait_s)
-      : bus_(bus), node_(node), encoder_(node, counter), wait_s_(wait_s) {}
-
-  std::optional<ParameterReply> access(ParameterOp op, uint8_t field, float value = 0.0f) {
-    const auto deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(
-                                             std::chrono::duration<double>(wait_s_));
-    while (g_stop == 0) {
-      if (!bus_.try_send(encoder_.encode(parameter_command(op, field, value)))) return {};
-      std::optional<ParameterReply> reply;
-      receive_until(bus_, wait_s_, [&](const hal::CanFrame& f) {
-        reply = decode_parameter_value(f, node_);
-        return reply && reply->op == op && (op == ParameterOp::save || reply->field == field);
-      });
-      if (!reply || reply->status != ParameterStatus::busy || Clock::now() >= deadline) {
-        return reply;
-      }
-      std::this_thread::sleep_for(std::chrono::milliseconds(20));
-    }
-    return {};
-  }
-
- private:
-  hal::SocketCanBus& bus_;
-  uint8_t node_;
-  protocol::CommandEncoder encoder_;
-  double wait_s_;
-};
 
 /// The shortest text that reads back as the same float.
 std::string fmt_float(float value) {
@@ -66,14 +35,15 @@ std::string value_text(float value) {
 }  // namespace
 
 CLI::App* add_parameters_command(CLI::App& app, ParametersOptions& o) {
-  CLI::App* c = app.add_subcommand(
-      "parameters", "Read the drive's motor parameters; write, save, export them");
+  CLI::App* c = app.add_subcommand("parameters",
+                                   "Read the drive's motor parameters; write, save, export them");
   c->add_option("--can", o.can, "CAN interface (SocketCAN), e.g. can0")->required();
   c->add_option("--node", o.node, "Node id of the drive")
       ->check(CLI::Range(0, protocol::kMaxNodeId))
       ->required();
-  c->add_option("--set", o.sets, "Write a field, KEY=VALUE (repeatable; keys: " +
-                                     field_names() + "); only while the drive is idle");
+  c->add_option("--set", o.sets,
+                "Write a field, KEY=VALUE (repeatable; keys: " + field_names() +
+                    "); only while the drive is idle");
   c->add_option("--motor-file", o.motor_file, "Write every field of this motor file");
   c->add_flag("--save", o.save, "Save the record to the drive's storage (after any writes)");
   c->add_option("--motor-out", o.motor_out, "Write what the drive holds as a motor file");
@@ -121,7 +91,7 @@ int run_parameters(const ParametersOptions& o) {
                     seconds_text(o.wait_heartbeat_s) + " s",
                 kExitNoAnswer);
   }
-  Session session(*bus, node, static_cast<uint8_t>((*last + 1) & 0x0F), o.wait_s);
+  ParameterSession session(*bus, node, static_cast<uint8_t>((*last + 1) & 0x0F), o.wait_s);
 
   int status = 0;
   // A new motor's inductances may pass through a record without leakage when written one at a
@@ -147,6 +117,12 @@ int run_parameters(const ParametersOptions& o) {
     std::cout << "save: " << status_name(reply->status) << '\n';
     if (reply->status != ParameterStatus::ok) status = kExitRejected;
   }
+  const int read_status = read_record(session, o.node, o.can, o.motor_out);
+  return read_status != 0 ? read_status : status;
+}
+
+int read_record(ParameterSession& session, int node, const std::string& can,
+                const std::string& motor_out) {
   control::MotorParameters read;
   bool complete = false, saved = false;
   for (int i = 0; i < firmware::kRecordFieldCount; ++i) {
@@ -161,15 +137,15 @@ int run_parameters(const ParametersOptions& o) {
   }
   std::cout << "record: " << (complete ? "complete" : "incomplete") << ", "
             << (saved ? "saved" : "not saved") << '\n';
-  if (!o.motor_out.empty()) {
+  if (!motor_out.empty()) {
     if (!complete) return fail("--motor-out: the drive holds no complete record", kExitRejected);
-    std::ofstream file(o.motor_out, std::ios::trunc);
-    file << sim::motor_file_text(read, "node " + std::to_string(o.node) + " on " + o.can,
-                                 "Motor parameters read from the drive (drive_monitor parameters).\n"
+    std::ofstream file(motor_out, std::ios::trunc);
+    file << sim::motor_file_text(read, "node " + std::to_string(node) + " on " + can,
+                                 "Motor parameters read from the drive (drive_monitor).\n"
                                  "Values are single precision, as the CAN message carries them.");
-    if (!file.flush()) return fail(o.motor_out + ": cannot write", kExitOutputError);
+    if (!file.flush()) return fail(motor_out + ": cannot write", kExitOutputError);
   }
-  return status;
+  return 0;
 }
 
 }  // namespace imd::monitor::cli

@@ -1,0 +1,101 @@
+#include "tools/drive_monitor/identify_cli.hpp"
+
+#include <iostream>
+#include <optional>
+
+#include "firmware/protocol/commands.hpp"
+#include "firmware/protocol/e2e.hpp"
+#include "tools/drive_monitor/cli_io.hpp"
+#include "tools/drive_monitor/parameter_access.hpp"
+#include "tools/drive_monitor/parameter_session.hpp"
+#include "tools/drive_monitor/send_command.hpp"
+
+namespace imd::monitor::cli {
+
+namespace protocol = firmware::protocol;
+
+CLI::App* add_identify_command(CLI::App& app, IdentifyOptions& o) {
+  CLI::App* c = app.add_subcommand(
+      "identify",
+      "Commission the motor: identify its parameters from the nameplate the drive "
+      "holds, show the progress, read back the result");
+  c->add_option("--can", o.can, "CAN interface (SocketCAN), e.g. can0")->required();
+  c->add_option("--node", o.node, "Node id of the drive")
+      ->check(CLI::Range(0, protocol::kMaxNodeId))
+      ->required();
+  c->add_flag("--rotate", o.rotate,
+              "After the standstill steps, turn the motor to measure inertia and friction (the "
+              "shaft must be free to turn); without it the drive keeps the mechanics it has");
+  c->add_option("--motor-out", o.motor_out, "Write the identified record as a motor file");
+  c->add_option("--timeout-s", o.timeout_s, "Give up waiting for the end after this long")
+      ->check(kSeconds)
+      ->capture_default_str();
+  c->add_option("--wait-s", o.wait_s, "How long to wait for each answer")
+      ->check(kSeconds)
+      ->capture_default_str();
+  c->add_option("--wait-heartbeat-s", o.wait_heartbeat_s,
+                "How long to wait for the heartbeat (it gives the alive counter)")
+      ->check(kSeconds)
+      ->capture_default_str();
+  return c;
+}
+
+int run_identify(const IdentifyOptions& o) {
+  std::string error;
+  const auto bus = hal::SocketCanBus::open(o.can, error);
+  if (!bus) return fail(error);
+  const auto node = static_cast<uint8_t>(o.node);
+  const StopSignals stop_signals;
+  std::optional<uint8_t> last;
+  receive_until(*bus, o.wait_heartbeat_s, [&](const hal::CanFrame& f) {
+    last = heartbeat_command_counter(f, node);
+    return last.has_value();
+  });
+  if (!last) {
+    return fail("no heartbeat from node " + std::to_string(o.node) + " on " + o.can + " within " +
+                    seconds_text(o.wait_heartbeat_s) + " s",
+                kExitNoAnswer);
+  }
+  ParameterSession session(*bus, node, static_cast<uint8_t>((*last + 1) & 0x0F), o.wait_s);
+  const protocol::Command identify{protocol::CommandKind::identify, o.rotate ? 1.0f : 0.0f};
+  const hal::CanFrame frame = session.encode(identify);
+  if (!bus->try_send(frame)) return fail("identify: cannot send", kExitNoAnswer);
+  std::optional<Ack> ack;
+  receive_until(*bus, o.wait_s, [&](const hal::CanFrame& f) {
+    ack = match_ack(f, node, uint8_t(protocol::MessageId::identify),
+                    protocol::e2e_counter(frame.data));
+    return ack.has_value();
+  });
+  if (!ack) return fail("identify: no acknowledgement", kExitNoAnswer);
+  if (ack->result != protocol::CommandResult::accepted) {
+    return fail("identify: rejected (" + result_name(ack->result) +
+                    "): the drive must be idle or unconfigured, with its enable line on",
+                kExitRejected);
+  }
+  // The progress at 10 Hz: a line per step, the fraction on the same line as it grows.
+  std::optional<IdentifyProgress> progress;
+  bool started = false;
+  uint8_t shown_step = 0xFF;
+  receive_until(*bus, o.timeout_s, [&](const hal::CanFrame& f) {
+    const auto p = decode_identify_progress(f, node);
+    if (!p) return false;
+    started = started || p->running();
+    if (!started) return false;  // the frame before the run began still shows the last one's end
+    if (p->step != shown_step && shown_step != 0xFF) std::cout << '\n';
+    shown_step = p->step;
+    std::cout << '\r' << progress_text(*p) << "    " << std::flush;
+    progress = p;
+    return p->ended();
+  });
+  std::cout << '\n';
+  if (!progress || !progress->ended()) {
+    return fail(g_stop != 0 ? "identify: stopped (the drive goes on; a disable aborts it)"
+                            : "identify: no end within " + seconds_text(o.timeout_s) + " s",
+                kExitNoAnswer);
+  }
+  if (progress->step != 4) return fail("identify: " + progress_text(*progress), kExitRejected);
+  // The drive applies and saves the record outside its tick: a read waits while it is busy.
+  return read_record(session, o.node, o.can, o.motor_out);
+}
+
+}  // namespace imd::monitor::cli
