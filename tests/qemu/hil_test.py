@@ -138,6 +138,20 @@ def check_parameters(out, c):
     leak = steps.get("no leakage", "")
     c.check("write Lm_H = 0.5: no_leakage" in leak and "Lm_H = 0.377" in leak and
             "exit 3" in leak, "Lm^2 >= Ls Lr is refused and changes nothing")
+    identify = steps.get("identify", "")
+    c.check("done (" in identify and "record: complete, saved" in identify and
+            identify.rstrip().endswith("exit 0"),
+            "drive_monitor identify commissions the motor and reads the record back",
+            identify.strip().splitlines()[-1] if identify.strip() else "no output")
+    identified = out / "identified.toml"
+    rs = None
+    if identified.exists():
+        for line in identified.read_text().splitlines():
+            if line.startswith("Rs_Ohm = "):
+                rs = float(line.split("=")[1])
+    # The standstill bound of docs/identification.md (2 %) on paper 000's 14 Ohm.
+    c.check(rs is not None and abs(rs / 14.0 - 1) < 0.02,
+            "the identified Rs is within 2 % of the plant's", f"Rs {rs}")
     exported = (out / "motor_out.toml").read_text()
     c.check("Rs_Ohm = 14.0" in exported and "pole_pairs = 1" in exported,
             "the record read back is written as a motor file")
