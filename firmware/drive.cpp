@@ -207,7 +207,8 @@ inline LawOutput<T> Drive<T>::law(const TickPlan<T>& plan, const Estimate<T>& e,
                                   MotorModel<T>* model) noexcept {
   record_.law.speed_saturated = record_.law.flux_saturated = record_.law.iol_boundary = false;
   record_.law.voltage_limited = false;
-  if (plan.mode == Mode::off || model == nullptr) return {};
+  // The commissioning drives the motor itself; a law would run on no estimate.
+  if (plan.mode == Mode::off || plan.mode == Mode::identifying || model == nullptr) return {};
   const control::InputDisk<T> feasible = model->limits.feasible(e.x_input, v_bus_V);
   if (plan.mode == Mode::magnetizing) {
     return model->magnetizer.step(e.x_input, plan.next, supervisor_.controlled_flux(), feasible);

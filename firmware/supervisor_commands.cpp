@@ -126,8 +126,14 @@ protocol::CommandResult Supervisor<T>::apply(const protocol::Command& c, uint64_
       const ParameterAccess request{protocol::ParameterOp::identify,
                                     static_cast<uint8_t>(c.value == 1.0f ? 1 : 0),
                                     float(v_bus_V_), true};
-      return wiring_.parameters->submit(request) ? CommandResult::accepted
-                                                 : CommandResult::not_allowed;
+      if (!wiring_.parameters->submit(request)) return CommandResult::not_allowed;
+      // A run of its own from here: no progress frame until it starts or fails, so every
+      // identify_progress after this command's ack reports this run, not the one before.
+      status_.identify_step = 6;  // none
+      status_.identify_failure = 0;
+      status_.identify_fraction = 0.0f;
+      status_.identify_start_tick = k;
+      return CommandResult::accepted;
     }
   }
   return CommandResult::unknown_message;
@@ -172,6 +178,7 @@ void Supervisor<T>::answer_served_access(uint64_t k) noexcept {
       status_.identify_fraction = 0.0f;
       status_.identify_start_tick = k;
     } else {
+      status_.identify_start_tick = k;  // the attempt's own time base
       status_.identify_step = 5;                                   // failed
       status_.identify_failure = a->status == ParameterStatus::not_set ? 4 : 5;  // no nameplate
     }

@@ -66,9 +66,9 @@ struct IdentifyRig {
     b.inverter.device_drop_V = 1.0;
     return b;
   }
-  IdentifyRig()
+  explicit IdentifyRig(const std::optional<MotorRecord>& record = std::nullopt)
       : board(small_motor(), board_config()),
-        drive(std::nullopt, config(),
+        drive(record, config(),
               {board.pwm(), board.encoder(), board.adc(), board.timer(), &board.can(), nullptr,
                &store}) {
     board.timer().start(drive);
@@ -186,6 +186,31 @@ TEST(DriveIdentification, AllowedToTurnItMeasuresTheMechanicsToo) {
   EXPECT_NEAR(m.friction_Nms, truth.friction_Nms, 0.1 * truth.friction_Nms + 0.01 * 0.43 / 47.1);
   EXPECT_GT(rig.theta_max_rad, 2.0 * std::numbers::pi);  // it did turn
   EXPECT_LT(std::abs(rig.board.plant().state().omega_mech_rad_s), 2.0);  // and was braked
+}
+
+// A drive already running on a record (here one with a cold rotor's resistance, half the true
+// one) is commissioned from idle: its law stays out of the way while the commissioning drives
+// the motor, and the result replaces the record.
+TEST(DriveIdentification, ADriveWithARecordIsCommissionedFromIdle) {
+  control::MotorParameters cold = small_motor();
+  cold.Rr_Ohm *= 0.5;
+  IdentifyRig rig{MotorRecord(cold)};
+  rig.run(300);
+  ASSERT_EQ(rig.drive.state(), DriveState::idle);
+  rig.nameplate();
+  rig.send({CommandKind::identify});
+  rig.run(3);
+  ASSERT_EQ(rig.drive.state(), DriveState::identifying);
+  for (int ticks = 0; rig.drive.state() == DriveState::identifying && ticks < 200'000;
+       ticks += 100) {
+    rig.run(100);
+  }
+  rig.run(1003);
+  ASSERT_EQ(rig.drive.state(), DriveState::idle) << "fault " << int(rig.drive.fault());
+  EXPECT_EQ(rig.progress(), std::make_pair(4, 0));  // done, no failure
+  const control::MotorParameters m = *rig.drive.motor();
+  EXPECT_LT(relative_error(m.Lr_H / m.Rr_Ohm, small_motor().Lr_H / small_motor().Rr_Ohm), 0.05);
+  EXPECT_EQ(m.J_kgm2, cold.J_kgm2);  // standstill only: the record's mechanics are kept
 }
 
 TEST(DriveIdentification, ADisableAbortsTheRunWithThePwmOff) {

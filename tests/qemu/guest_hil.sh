@@ -99,17 +99,19 @@ P="drive_monitor parameters $NODE --wait-s 5 --wait-heartbeat-s 5"
   $P --motor-file /hil/hal_sim/motors/seed000.toml --save --motor-out /tmp/motor_out.toml
   echo "exit $?"
   echo "step no leakage"; $P --set Lm_H=0.5; echo "exit $?"
-  echo "step identify"
+} > /tmp/parameters.log 2>&1
+say "commissioning at standstill: the nameplate, then drive_monitor identify"
+{
   $P --set rated_voltage_V=220 --set rated_current_A=2.5 --set rated_frequency_Hz=50
-  drive_monitor identify $NODE --wait-s 5 --wait-heartbeat-s 5 --timeout-s 300 \
+  drive_monitor identify $NODE --wait-s 5 --wait-heartbeat-s 5 --timeout-s 60 \
     --motor-out /tmp/identified.toml
   echo "exit $?"
-} > /tmp/parameters.log 2>&1
+} > /tmp/identify.log 2>&1
 kill -TERM $HIL; wait $HIL
 # The next power-up starts from the saved record: calibrated, then idle.
 drive_hil $S/hil.toml $NODE --parameters /tmp/motor.rec --duration-s 6 > /tmp/param_hil2.log 2>&1
 echo "drive_hil exit $?" >> /tmp/param_hil2.log
-for f in parameters.log param_hil.log param_hil2.log motor_out.toml identified.toml; do
+for f in parameters.log identify.log param_hil.log param_hil2.log motor_out.toml identified.toml; do
   [ -f /tmp/$f ] && emit $f /tmp/$f
 done
 

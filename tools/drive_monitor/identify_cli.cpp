@@ -72,15 +72,14 @@ int run_identify(const IdentifyOptions& o) {
                     "): the drive must be idle or unconfigured, with its enable line on",
                 kExitRejected);
   }
-  // The progress at 10 Hz: a line per step, the fraction on the same line as it grows.
+  // The progress at 10 Hz: a line per step, the fraction on the same line as it grows. The
+  // drive sends none between the ack and the run's start (or its refusal): every frame from
+  // here on is this run's.
   std::optional<IdentifyProgress> progress;
-  bool started = false;
   uint8_t shown_step = 0xFF;
   receive_until(*bus, o.timeout_s, [&](const hal::CanFrame& f) {
     const auto p = decode_identify_progress(f, node);
     if (!p) return false;
-    started = started || p->running();
-    if (!started) return false;  // the frame before the run began still shows the last one's end
     if (p->step != shown_step && shown_step != 0xFF) std::cout << '\n';
     shown_step = p->step;
     std::cout << '\r' << progress_text(*p) << "    " << std::flush;
