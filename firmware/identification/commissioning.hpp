@@ -18,7 +18,9 @@ class Commissioning {
 
   /// `rotating`: the rotating step's plan, or none to keep the mechanics.
   Commissioning(const IdentificationPlan& standstill, const std::optional<InertiaPlan>& rotating)
-      : standstill_(standstill), rotating_(rotating) {}
+      : standstill_(standstill) {
+    if (rotating) rotating_.emplace(*rotating);
+  }
 
   Vec2 step(const Vec2& i_A, int32_t encoder_delta_counts) noexcept {
     if (inertia_) return inertia_->step(i_A, encoder_delta_counts);
@@ -84,7 +86,7 @@ class Commissioning {
   }
 
   StandstillIdentifier<T> standstill_;
-  std::optional<InertiaPlan> rotating_;
+  std::optional<InertiaSettings<T>> rotating_;
   std::optional<InertiaIdentifier<T>> inertia_;
 };
 

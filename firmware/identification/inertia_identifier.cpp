@@ -6,40 +6,40 @@
 namespace imd::firmware {
 
 template <typename T>
-InertiaIdentifier<T>::InertiaIdentifier(const InertiaPlan& plan,
+InertiaIdentifier<T>::InertiaIdentifier(const InertiaSettings<T>& plan,
                                         const StandstillResult<T>& motor) noexcept
-    : period_s_(T(plan.period_s)),
-      rad_per_count_(T(plan.rad_per_count)),
-      pole_pairs_(T(plan.pole_pairs)),
-      v_limit_V_(T(plan.v_limit_V)),
+    : period_s_(plan.period_s),
+      rad_per_count_(plan.rad_per_count),
+      pole_pairs_(plan.pole_pairs),
+      v_limit_V_(plan.v_limit_V),
       Lm2_over_Lr_H_(motor.Lm2_over_Lr_H),
       tau_r_s_(motor.tau_r_s),
       sigma_Ls_H_(motor.sigma_Ls_H),
-      kp_Ohm_(motor.sigma_Ls_H * T(plan.crossover_rad_s)),
-      ki_T_Ohm_(motor.Rs_Ohm * T(plan.crossover_rad_s * plan.period_s)),
-      flux_decay_(std::exp(-T(plan.period_s) / motor.tau_r_s)) {
+      kp_Ohm_(motor.sigma_Ls_H * plan.crossover_rad_s),
+      ki_T_Ohm_(motor.Rs_Ohm * plan.crossover_rad_s * plan.period_s),
+      flux_decay_(std::exp(-plan.period_s / motor.tau_r_s)),
+      max_accelerate_ticks_(plan.max_accelerate_ticks),
+      max_coast_ticks_(plan.max_coast_ticks),
+      ramp_ticks_(plan.ramp_ticks) {
   // Rules (docs/identification.md, "Inertia and friction"):
   // * the field at the motor's no-load magnetizing current, V_phase / (omega_rated Ls), at
   //   most 0.7 of the test's current limit;
   // * the test speed at 0.3 of rated, and at most where the back EMF takes half the voltage;
   // * the torque current so that the inertia guessed from the nameplate reaches the test
   //   speed in accelerate_s, between 0.1 and 0.5 of the current the field leaves.
-  const T i_limit_A = T(plan.i_limit_A);
-  i_d_A_ = std::min(T(plan.v_phase_peak_V) / (T(plan.omega_rated_rad_s) * motor.Ls_H),
+  const T i_limit_A = plan.i_limit_A;
+  i_d_A_ = std::min(plan.v_phase_peak_V / (plan.omega_rated_rad_s * motor.Ls_H),
                     T(0.7) * i_limit_A);
-  const T omega_e_test =
-      std::min(T(0.3) * T(plan.omega_rated_rad_s), T(0.5) * v_limit_V_ / (motor.Ls_H * i_d_A_));
+  const T omega_e_test = std::min(T(0.3) * plan.omega_rated_rad_s,
+                                  T(0.5) * v_limit_V_ / (motor.Ls_H * i_d_A_));
   omega_test_rad_s_ = omega_e_test / pole_pairs_;
   k_torque_Nm_per_A_ = T(1.5) * pole_pairs_ * Lm2_over_Lr_H_ * i_d_A_;
   const T i_free_A = std::sqrt(std::max(T(0), i_limit_A * i_limit_A - i_d_A_ * i_d_A_));
   const T i_q_wanted_A =
-      T(plan.J_guess_kgm2) * omega_test_rad_s_ / (T(plan.accelerate_s) * k_torque_Nm_per_A_);
+      plan.J_guess_kgm2 * omega_test_rad_s_ / (plan.accelerate_s * k_torque_Nm_per_A_);
   i_q_A_ = std::clamp(i_q_wanted_A, T(0.1) * i_free_A, T(0.5) * i_free_A);
   const T flux_s = std::max(T(5) * motor.tau_r_s, T(0.05));
   flux_ticks_ = static_cast<uint32_t>(flux_s / period_s_);
-  max_accelerate_ticks_ = static_cast<uint32_t>(plan.max_accelerate_s / plan.period_s);
-  max_coast_ticks_ = static_cast<uint32_t>(plan.max_coast_s / plan.period_s);
-  ramp_ticks_ = static_cast<uint32_t>(0.05 / plan.period_s);
 }
 
 template <typename T>

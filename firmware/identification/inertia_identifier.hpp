@@ -44,6 +44,29 @@ struct InertiaPlan {
   double crossover_rad_s = 2.0 * 3.14159265358979 * 200.0;  ///< current loop bandwidth
 };
 
+/// The plan in the tick's arithmetic, converted outside the tick (the rotating step is built
+/// in the tick, when the standstill steps end, and must not touch double there).
+template <typename T>
+struct InertiaSettings {
+  explicit InertiaSettings(const InertiaPlan& p)
+      : period_s(T(p.period_s)),
+        rad_per_count(T(p.rad_per_count)),
+        omega_rated_rad_s(T(p.omega_rated_rad_s)),
+        v_phase_peak_V(T(p.v_phase_peak_V)),
+        i_limit_A(T(p.i_limit_A)),
+        v_limit_V(T(p.v_limit_V)),
+        J_guess_kgm2(T(p.J_guess_kgm2)),
+        pole_pairs(T(p.pole_pairs)),
+        accelerate_s(T(p.accelerate_s)),
+        crossover_rad_s(T(p.crossover_rad_s)),
+        max_accelerate_ticks(static_cast<uint32_t>(p.max_accelerate_s / p.period_s)),
+        max_coast_ticks(static_cast<uint32_t>(p.max_coast_s / p.period_s)),
+        ramp_ticks(static_cast<uint32_t>(0.05 / p.period_s)) {}
+  T period_s, rad_per_count, omega_rated_rad_s, v_phase_peak_V, i_limit_A, v_limit_V;
+  T J_guess_kgm2, pole_pairs, accelerate_s, crossover_rad_s;
+  uint32_t max_accelerate_ticks, max_coast_ticks, ramp_ticks;
+};
+
 template <typename T>
 struct Mechanics {
   T J_kgm2 = T(0), friction_Nms = T(0);
@@ -56,7 +79,7 @@ class InertiaIdentifier {
 
   /// Sizes the test from the plan and the identified electrical parameters (tick context: a
   /// few divisions and square roots, once).
-  InertiaIdentifier(const InertiaPlan& plan, const StandstillResult<T>& motor) noexcept;
+  InertiaIdentifier(const InertiaSettings<T>& plan, const StandstillResult<T>& motor) noexcept;
 
   /// One tick: the measured current and the encoder's counts over the last period in; the
   /// alpha-beta voltage out (acting over the period after next).
