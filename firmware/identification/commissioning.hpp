@@ -53,7 +53,8 @@ class Commissioning {
         return static_cast<uint8_t>(7 + int(inertia_->current_step()));
     }
   }
-  /// The protocol's identify_failure code (7: done, the rotor did not turn, mechanics kept).
+  /// The protocol's identify_failure code (7: done, the rotor did not turn, mechanics kept;
+  /// 8 wrong_direction, 9 overspeed, 10 not_at_rest).
   uint8_t failure_code() const noexcept {
     if (!inertia_) return static_cast<uint8_t>(standstill_.failure());
     switch (inertia_->outcome()) {
@@ -63,6 +64,12 @@ class Commissioning {
         return static_cast<uint8_t>(IdentificationFailure::implausible);
       case InertiaOutcome::no_motion:
         return 7;
+      case InertiaOutcome::wrong_direction:
+        return 8;
+      case InertiaOutcome::overspeed:
+        return 9;
+      case InertiaOutcome::not_at_rest:
+        return 10;
       case InertiaOutcome::running:
       case InertiaOutcome::measured:
         break;

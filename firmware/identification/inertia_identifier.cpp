@@ -20,7 +20,8 @@ InertiaIdentifier<T>::InertiaIdentifier(const InertiaSettings<T>& plan,
       flux_decay_(std::exp(-plan.period_s / motor.tau_r_s)),
       max_accelerate_ticks_(plan.max_accelerate_ticks),
       max_coast_ticks_(plan.max_coast_ticks),
-      ramp_ticks_(plan.ramp_ticks) {
+      ramp_ticks_(plan.ramp_ticks),
+      brake_extra_ticks_(plan.brake_extra_ticks) {
   // Rules (docs/identification.md, "Inertia and friction"):
   // * the field at the motor's no-load magnetizing current, V_phase / (omega_rated Ls), at
   //   most 0.7 of the test's current limit;
@@ -28,10 +29,10 @@ InertiaIdentifier<T>::InertiaIdentifier(const InertiaSettings<T>& plan,
   // * the torque current so that the inertia guessed from the nameplate reaches the test
   //   speed in accelerate_s, between 0.1 and 0.5 of the current the field leaves.
   const T i_limit_A = plan.i_limit_A;
-  i_d_A_ = std::min(plan.v_phase_peak_V / (plan.omega_rated_rad_s * motor.Ls_H),
-                    T(0.7) * i_limit_A);
-  const T omega_e_test = std::min(T(0.3) * plan.omega_rated_rad_s,
-                                  T(0.5) * v_limit_V_ / (motor.Ls_H * i_d_A_));
+  i_d_A_ =
+      std::min(plan.v_phase_peak_V / (plan.omega_rated_rad_s * motor.Ls_H), T(0.7) * i_limit_A);
+  const T omega_e_test =
+      std::min(T(0.3) * plan.omega_rated_rad_s, T(0.5) * v_limit_V_ / (motor.Ls_H * i_d_A_));
   omega_test_rad_s_ = omega_e_test / pole_pairs_;
   k_torque_Nm_per_A_ = T(1.5) * pole_pairs_ * Lm2_over_Lr_H_ * i_d_A_;
   const T i_free_A = std::sqrt(std::max(T(0), i_limit_A * i_limit_A - i_d_A_ * i_d_A_));
@@ -45,8 +46,8 @@ InertiaIdentifier<T>::InertiaIdentifier(const InertiaSettings<T>& plan,
 template <typename T>
 void InertiaIdentifier<T>::stop(InertiaOutcome why) noexcept {
   outcome_ = why;
-  if (why == InertiaOutcome::voltage_limit || why == InertiaOutcome::implausible) {
-    enter(InertiaStep::failed);
+  if (why != InertiaOutcome::measured && why != InertiaOutcome::no_motion) {
+    enter(InertiaStep::failed);  // the PWM goes off; the motor coasts
   } else {
     omega_brake_from_rad_s_ = omega_block_rad_s_;
     enter(InertiaStep::brake);
@@ -63,7 +64,14 @@ void InertiaIdentifier<T>::take_row(int row) noexcept {
 template <typename T>
 void InertiaIdentifier<T>::solve() noexcept {
   // J theta_i + B Theta_i = Y_i, i = end of acceleration, end of coast.
-  const T det = row_theta_[0] * row_int_theta_[1] - row_theta_[1] * row_int_theta_[0];
+  const T a = row_theta_[0] * row_int_theta_[1], b = row_theta_[1] * row_int_theta_[0];
+  const T det = a - b;
+  // A coast that barely moved on makes the two rows one: nothing to solve (a normal run's
+  // determinant is about half its larger term).
+  if (!(std::abs(det) > T(0.05) * std::max(std::abs(a), std::abs(b)))) {
+    stop(InertiaOutcome::implausible);
+    return;
+  }
   const T J =
       (row_int2_torque_[0] * row_int_theta_[1] - row_int2_torque_[1] * row_int_theta_[0]) / det;
   const T B = (row_theta_[0] * row_int2_torque_[1] - row_theta_[1] * row_int2_torque_[0]) / det;
@@ -99,11 +107,32 @@ control::Vec2<T> InertiaIdentifier<T>::step(const Vec2& i_A,
   }
   omega_e_rad_s_ = pole_pairs_ * omega_block_rad_s_ + slip_rad_s_;
 
+  // The drive's own overspeed check needs the observers, which do not run here: this step
+  // guards its speed itself. A rotor that turns against the torque's direction means an
+  // encoder counting against the phase sequence, and a field that cannot be oriented.
+  if (std::abs(omega_block_rad_s_) > T(2) * omega_test_rad_s_) {
+    stop(InertiaOutcome::overspeed);
+    return Vec2::Zero();
+  }
+  // From rest under a positive torque the angle only grows; 5 degrees the other way is no
+  // quantization.
+  if (step_ == InertiaStep::accelerate && T(counts_) * rad_per_count_ < T(-0.087)) {
+    stop(InertiaOutcome::wrong_direction);
+    return Vec2::Zero();
+  }
+
   T i_q_ref_A = T(0);
   switch (step_) {
     case InertiaStep::flux_up:
       i_d_ref_A_ = i_d_A_;
-      if (ticks_ >= flux_ticks_) enter(InertiaStep::accelerate);
+      if (ticks_ >= flux_ticks_) {
+        // The equations start from rest.
+        if (std::abs(omega_block_rad_s_) > T(0.02) * omega_test_rad_s_) {
+          stop(InertiaOutcome::not_at_rest);
+          return Vec2::Zero();
+        }
+        enter(InertiaStep::accelerate);
+      }
       break;
     case InertiaStep::accelerate:
     case InertiaStep::coast: {
@@ -114,21 +143,24 @@ control::Vec2<T> InertiaIdentifier<T>::step(const Vec2& i_A,
       if (step_ == InertiaStep::accelerate) {
         i_q_ref_A = i_q_A_;
         const bool at_speed = omega_block_rad_s_ >= omega_test_rad_s_;
-        if (at_speed || ticks_ >= max_accelerate_ticks_) {
-          if (omega_block_rad_s_ < T(0.2) * omega_test_rad_s_) {
-            stop(InertiaOutcome::no_motion);
-          } else {
-            take_row(0);
-            accelerate_ticks_ = ticks_;
-            enter(InertiaStep::coast);
-          }
+        if (at_speed) {
+          take_row(0);
+          accelerate_ticks_ = ticks_;
+          omega_coast_from_rad_s_ = omega_block_rad_s_;
+          enter(InertiaStep::coast);
+        } else if (ticks_ >= max_accelerate_ticks_) {
+          accelerate_ticks_ = ticks_;       // what the brake may take
+          stop(InertiaOutcome::no_motion);  // too heavy or too loaded for this test
         }
       } else {
-        // As long as the acceleration took (at least 0.1 s); shorter if friction stops it.
+        // As long as the acceleration took (at least 0.1 s); shorter if friction halves the
+        // speed first.
+        const auto min_ticks = static_cast<uint32_t>(T(0.1) / period_s_);
         const uint32_t coast_ticks =
-            std::min(std::max(accelerate_ticks_, static_cast<uint32_t>(T(0.1) / period_s_)),
-                     max_coast_ticks_);
-        if (ticks_ >= coast_ticks || omega_block_rad_s_ < T(0.5) * omega_test_rad_s_) {
+            std::min(std::max(accelerate_ticks_, min_ticks), max_coast_ticks_);
+        const bool slowed =
+            ticks_ >= min_ticks && omega_block_rad_s_ < T(0.5) * omega_coast_from_rad_s_;
+        if (ticks_ >= coast_ticks || slowed) {
           take_row(1);
           solve();
         }
@@ -137,7 +169,12 @@ control::Vec2<T> InertiaIdentifier<T>::step(const Vec2& i_A,
     }
     case InertiaStep::brake:
       i_q_ref_A = omega_block_rad_s_ > T(0) ? -i_q_A_ : T(0);
-      if (omega_block_rad_s_ <= T(0.02) * omega_test_rad_s_) enter(InertiaStep::ramp_down);
+      if (omega_block_rad_s_ <= T(0.02) * omega_test_rad_s_) {
+        enter(InertiaStep::ramp_down);
+      } else if (ticks_ > accelerate_ticks_ + brake_extra_ticks_) {
+        stop(InertiaOutcome::not_at_rest);  // something drives the shaft: PWM off
+        return Vec2::Zero();
+      }
       break;
     case InertiaStep::ramp_down:
       i_d_ref_A_ = i_d_A_ * (T(1) - std::min(T(1), T(ticks_) / T(ramp_ticks_)));

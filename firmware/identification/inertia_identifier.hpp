@@ -9,6 +9,7 @@
 /// the current model. The ends of the acceleration and of the coast give two such equations;
 /// they solve for J and B. A rotor that does not turn (a locked or heavily loaded shaft) skips
 /// the step and leaves the mechanics unmeasured. Tick context, T = float on the MCU.
+#include <algorithm>
 #include <cstdint>
 
 #include "control/frames.hpp"
@@ -21,10 +22,13 @@ enum class InertiaStep : uint8_t { flux_up, accelerate, coast, brake, ramp_down,
 
 enum class InertiaOutcome : uint8_t {
   running,
-  measured,       ///< J and B identified
-  no_motion,      ///< the rotor did not reach a fifth of the test speed: mechanics kept
-  voltage_limit,  ///< the current loop ran out of voltage
-  implausible,    ///< J not positive or not finite
+  measured,         ///< J and B identified
+  no_motion,        ///< the rotor did not reach a fifth of the test speed: mechanics kept
+  voltage_limit,    ///< the current loop ran out of voltage
+  implausible,      ///< J not positive or not finite
+  wrong_direction,  ///< the encoder counts against the phase sequence (swap two phases or A/B)
+  overspeed,        ///< the speed passed twice the test speed: the field is not oriented
+  not_at_rest,      ///< turning when the step began, or not braked to rest in time
 };
 
 /// What the rotating step is planned from besides the standstill result (double, outside the
@@ -41,6 +45,7 @@ struct InertiaPlan {
   double accelerate_s = 1.0;       ///< planned acceleration time with J_guess
   double max_accelerate_s = 30.0;  ///< beyond this with no motion: skipped
   double max_coast_s = 10.0;
+  double max_brake_extra_s = 1.0;  ///< the brake may take the acceleration's time plus this
   double crossover_rad_s = 2.0 * 3.14159265358979 * 200.0;  ///< current loop bandwidth
 };
 
@@ -58,13 +63,16 @@ struct InertiaSettings {
         J_guess_kgm2(T(p.J_guess_kgm2)),
         pole_pairs(T(p.pole_pairs)),
         accelerate_s(T(p.accelerate_s)),
-        crossover_rad_s(T(p.crossover_rad_s)),
+        // At most a twentieth of the sample rate: the 1.5 periods of delay then cost 27 deg.
+        crossover_rad_s(
+            T(std::min(p.crossover_rad_s, 2.0 * 3.14159265358979 / (20.0 * p.period_s)))),
         max_accelerate_ticks(static_cast<uint32_t>(p.max_accelerate_s / p.period_s)),
         max_coast_ticks(static_cast<uint32_t>(p.max_coast_s / p.period_s)),
-        ramp_ticks(static_cast<uint32_t>(0.05 / p.period_s)) {}
+        ramp_ticks(static_cast<uint32_t>(0.05 / p.period_s)),
+        brake_extra_ticks(static_cast<uint32_t>(p.max_brake_extra_s / p.period_s)) {}
   T period_s, rad_per_count, omega_rated_rad_s, v_phase_peak_V, i_limit_A, v_limit_V;
   T J_guess_kgm2, pole_pairs, accelerate_s, crossover_rad_s;
-  uint32_t max_accelerate_ticks, max_coast_ticks, ramp_ticks;
+  uint32_t max_accelerate_ticks, max_coast_ticks, ramp_ticks, brake_extra_ticks;
 };
 
 template <typename T>
@@ -112,7 +120,7 @@ class InertiaIdentifier {
   T period_s_, rad_per_count_, pole_pairs_, v_limit_V_;
   T Lm2_over_Lr_H_, tau_r_s_, sigma_Ls_H_, kp_Ohm_, ki_T_Ohm_, flux_decay_;
   T i_d_A_, i_q_A_, omega_test_rad_s_, k_torque_Nm_per_A_;
-  uint32_t flux_ticks_, max_accelerate_ticks_, max_coast_ticks_, ramp_ticks_;
+  uint32_t flux_ticks_, max_accelerate_ticks_, max_coast_ticks_, ramp_ticks_, brake_extra_ticks_;
 
   InertiaStep step_ = InertiaStep::flux_up;
   InertiaOutcome outcome_ = InertiaOutcome::running;
@@ -126,7 +134,7 @@ class InertiaIdentifier {
   // The speed over 10 ms blocks of encoder counts.
   int32_t block_counts_ = 0;
   uint32_t block_ticks_ = 0;
-  T omega_block_rad_s_ = T(0), omega_brake_from_rad_s_ = T(0);
+  T omega_block_rad_s_ = T(0), omega_brake_from_rad_s_ = T(0), omega_coast_from_rad_s_ = T(0);
   // The integrals from rest: counts (exact), Int theta, Int Te, Int Int Te.
   int32_t counts_ = 0;
   CompensatedSum<T> int_theta_, int_torque_, int2_torque_;

@@ -18,15 +18,15 @@ struct Nameplate {
 struct IdentificationPlan {
   double period_s = 1e-4;
   double i_low_A = 0.0, i_high_A = 0.0;  ///< the two DC levels
-  double sigma_Ls_guess_H = 0.0;  ///< the transient inductance expected from the nameplate
+  double sigma_Ls_guess_H = 0.0;         ///< the transient inductance expected from the nameplate
   double kp_Ohm = 0.0, ki_Ohm_per_s = 0.0;  ///< the current loop's PI
   double v_limit_V = 0.0;                   ///< the loop's output limit (linear SVPWM range)
   double hf_voltage_V = 0.0;                ///< square-wave amplitude of the sigma Ls step
   int hf_half_period_ticks = 2;
-  int hf_ticks = 2000;          ///< length of the square-wave injection
-  int window_ticks = 100;       ///< the settling detector's averaging window (10 ms)
-  double max_level_s = 60.0;    ///< a level that never settles fails the run
-  double ramp_down_s = 0.05;    ///< current to zero at the end
+  int hf_ticks = 2000;        ///< length of the square-wave injection
+  int window_ticks = 100;     ///< the settling detector's averaging window (10 ms)
+  double max_level_s = 60.0;  ///< a level that never settles fails the run
+  double ramp_down_s = 0.05;  ///< current to zero at the end
 };
 
 /// The rules (docs/identification.md, "Test levels and gains"):

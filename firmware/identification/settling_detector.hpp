@@ -8,8 +8,8 @@
 /// large motor, whose decay is a few times its noise). The level is settled once the segments
 /// span 9 tau (the tail left is e^-9 of the step), or once the first difference is lost in the
 /// noise (everything decayed within the first segment). The noise is estimated from second
-/// differences of consecutive windows, which a slow decay hardly reaches. The windows are kept as sums in
-/// buckets that double in length when full: no heap, bounded memory. Tick context.
+/// differences of consecutive windows, which a slow decay hardly reaches. The windows are kept as
+/// sums in buckets that double in length when full: no heap, bounded memory. Tick context.
 #include <array>
 #include <cmath>
 #include <cstdint>
@@ -19,7 +19,7 @@ namespace imd::firmware {
 template <typename T>
 class SettlingDetector {
  public:
-  static constexpr int kBuckets = 48;  ///< a multiple of 3
+  static constexpr int kBuckets = 48;     ///< a multiple of 3
   static constexpr int kMinWindows = 12;  ///< at least four windows per segment
 
   /// The next window's mean; `arrived`: the current is at its new level. True once settled
@@ -73,8 +73,8 @@ class SettlingDetector {
     // A segment mean's noise is that of a window over sqrt(L); a difference of two, sqrt(2)
     // more. Three of those is "significant".
     // A second difference of independent windows has six times a window's variance.
-    const T window_noise = differences_ > 0 ? std::sqrt(square_differences_ / T(6 * differences_))
-                                            : T(0);
+    const T window_noise =
+        differences_ > 0 ? std::sqrt(square_differences_ / T(6 * differences_)) : T(0);
     const T difference_noise = window_noise * std::sqrt(T(2) / windows_per_segment);
     const T significant = T(3) * difference_noise;
     if (std::abs(d1) <= significant) {  // decayed within the first segment, or no decay at all

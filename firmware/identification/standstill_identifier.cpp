@@ -34,8 +34,7 @@ control::Vec2<T> StandstillIdentifier<T>::current_loop(const Vec2& i_A, T i_ref_
 }
 
 template <typename T>
-bool StandstillIdentifier<T>::level(const Vec2& i_A, T v_acting_V, T i_ref_A,
-                                    T i_from_A) noexcept {
+bool StandstillIdentifier<T>::level(const Vec2& i_A, T v_acting_V, T i_ref_A, T i_from_A) noexcept {
   if (holding_) {
     hold_.v_V.add(v_acting_V);
     hold_.i_A.add(i_A.x());
@@ -83,13 +82,13 @@ control::Vec2<T> StandstillIdentifier<T>::step(const Vec2& i_A) noexcept {
       const T t_s = T(ticks_ - 1) * period_s_;
       const T v = u_acting_V_.x();
       if (!holding_) {
-      sv_.add(v * period_s_);
-      stv_.add((t_s + T(0.5) * period_s_) * v * period_s_);
-      si_.add(i_A.x() * period_s_);
-      sti_.add(t_s * i_A.x() * period_s_);
-      k0_.add(period_s_);
-      k1v_.add((t_s + T(0.5) * period_s_) * period_s_);
-      k1i_.add(t_s * period_s_);
+        sv_.add(v * period_s_);
+        stv_.add((t_s + T(0.5) * period_s_) * v * period_s_);
+        si_.add(i_A.x() * period_s_);
+        sti_.add(t_s * i_A.x() * period_s_);
+        k0_.add(period_s_);
+        k1v_.add((t_s + T(0.5) * period_s_) * period_s_);
+        k1i_.add(t_s * period_s_);
       }
       if (level(i_A, v, i_high_A_, i_low_A_)) {
         v_high_V_ = hold_.v_V.value() / T(hold_.ticks);

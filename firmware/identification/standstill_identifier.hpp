@@ -122,5 +122,3 @@ class StandstillIdentifier {
 };
 
 }  // namespace imd::firmware
-
-

@@ -130,6 +130,7 @@ inline constexpr ValueName kIdentifyFailureValues[] = {
     {0, "none"},        {1, "not_settled"}, {2, "voltage_limit"}, {3, "implausible"},
     {4, "no_nameplate"}, {5, "aborted"},    {6, "invalid_record"},
     {7, "no_motion"},  // done: the rotor did not turn, the mechanics were kept
+    {8, "wrong_direction"}, {9, "overspeed"}, {10, "not_at_rest"},
 };
 inline constexpr ValueName kParameterStatusValues[] = {
     {0, "ok"},         {1, "not_idle"},  {2, "unknown_field"}, {3, "not_finite"},
@@ -177,7 +178,7 @@ inline constexpr Signal kIdentifySignals[] = {
     kE2eCounter,
     {"rotate", 16, 8, false, 1, 1, 0.0f, "",
      "1: after the standstill steps, turn the motor to measure inertia and friction (the shaft "
-     "must be free to turn); 0: standstill only, the mechanics are kept",
+     "must be free to turn); 0: standstill only, the mechanics are kept; others are rejected",
      kIdentifyRotateValues}};
 inline constexpr Signal kSelectControllerSignals[] = {
     kE2eCrc,

@@ -38,7 +38,9 @@ class CommissioningWatch {
     if (drive.state() == firmware::DriveState::identifying) {
       started_ = true;
       if (status.identify_step < ticks_.size()) ++ticks_[status.identify_step];
-      if (status.identify_step != last_step_) order_.push_back(status.identify_step);
+      // The end (done, failed) is reported below, not as a step of its own.
+      const bool end = status.identify_step == 4 || status.identify_step == 5;
+      if (status.identify_step != last_step_ && !end) order_.push_back(status.identify_step);
       last_step_ = status.identify_step;
       return false;
     }

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "firmware/drive.hpp"
+#include "firmware/identification/inertia_plan.hpp"
 #include "firmware/parameters/motor_record.hpp"
 #include "firmware/protocol/frame_codec.hpp"
 #include "hal/storage/page_pair_store.hpp"
@@ -89,8 +90,8 @@ struct IdentifyRig {
     for (int k = 0; k < ticks; ++k) {
       board.run_tick();
       drive.service();
-      theta_max_rad = std::max(theta_max_rad,
-                               std::abs(board.plant().state().theta_mech_rad - theta_start_rad));
+      theta_max_rad =
+          std::max(theta_max_rad, std::abs(board.plant().state().theta_mech_rad - theta_start_rad));
       for (hal::CanFrame f; board.can_side().take_sent(f);) sent.push_back(f);
     }
   }
@@ -128,9 +129,9 @@ TEST(DriveIdentification, AnUnknownMotorIsIdentifiedStoredAndRun) {
     ticks += 1;
   }
   rig.run(3);  // the record applied outside the tick, the model attached
-  ASSERT_EQ(rig.drive.state(), DriveState::idle) << "progress step " << rig.progress().first
-                                                 << ", failure " << rig.progress().second;
-  rig.run(1000);  // the next 10 Hz progress frame reports the end
+  ASSERT_EQ(rig.drive.state(), DriveState::idle)
+      << "progress step " << rig.progress().first << ", failure " << rig.progress().second;
+  rig.run(1000);                                    // the next 10 Hz progress frame reports the end
   EXPECT_EQ(rig.progress(), std::make_pair(4, 0));  // done, no failure
   const control::MotorParameters& truth = small_motor();
   const control::MotorParameters m = *rig.drive.motor();
@@ -174,17 +175,30 @@ TEST(DriveIdentification, AllowedToTurnItMeasuresTheMechanicsToo) {
     accelerated = accelerated || rig.progress().first == 8;  // accelerate
   }
   rig.run(1003);
-  ASSERT_EQ(rig.drive.state(), DriveState::idle) << "progress step " << rig.progress().first
-                                                 << ", failure " << rig.progress().second;
+  ASSERT_EQ(rig.drive.state(), DriveState::idle)
+      << "progress step " << rig.progress().first << ", failure " << rig.progress().second;
   EXPECT_TRUE(accelerated);
   EXPECT_EQ(rig.progress(), std::make_pair(4, 0));  // done, no failure
   const control::MotorParameters& truth = small_motor();
   const control::MotorParameters m = *rig.drive.motor();
-  // The bound of docs/identification.md for J; the friction's of test_inertia_identification.cpp:
-  // 10 % of B plus 1 % of the test torque over the test speed (0.43 N m at 47 rad/s here).
+  // The bounds of test_inertia_identification.cpp: J 10 %; B 10 % plus 1 % of the test torque
+  // over the test speed, the operating point the drive planned for this nameplate and board.
+  StandstillResult<double> electrical;
+  electrical.Rs_Ohm = truth.Rs_Ohm;
+  electrical.Ls_H = truth.Ls_H;
+  electrical.Lm2_over_Lr_H = truth.Lm_H * truth.Lm_H / truth.Lr_H;
+  electrical.sigma_Ls_H = truth.Ls_H - electrical.Lm2_over_Lr_H;
+  electrical.tau_r_s = truth.Lr_H / truth.Rr_Ohm;
+  const InertiaIdentifier<double> test_point(
+      InertiaSettings<double>(plan_inertia_test({400.0, 1.9, 50.0, 2},
+                                                IdentifyRig::config().i_max_A, 540.0, 1e-4,
+                                                rig.board.config().encoder_cpr)),
+      electrical);
   EXPECT_LT(relative_error(m.J_kgm2, truth.J_kgm2), 0.10);
-  EXPECT_NEAR(m.friction_Nms, truth.friction_Nms, 0.1 * truth.friction_Nms + 0.01 * 0.43 / 47.1);
-  EXPECT_GT(rig.theta_max_rad, 2.0 * std::numbers::pi);  // it did turn
+  EXPECT_NEAR(
+      m.friction_Nms, truth.friction_Nms,
+      0.1 * truth.friction_Nms + 0.01 * test_point.torque_Nm() / test_point.test_speed_rad_s());
+  EXPECT_GT(rig.theta_max_rad, 2.0 * std::numbers::pi);                  // it did turn
   EXPECT_LT(std::abs(rig.board.plant().state().omega_mech_rad_s), 2.0);  // and was braked
 }
 

@@ -98,6 +98,10 @@ TEST(drive_monitor_identify, DecodesAndShowsTheProgress) {
   EXPECT_EQ(progress_text(*kept), "done: no_motion (5.0 s)");
   const auto failed = decode_identify_progress(progress_frame(2, 5.0f, 1.0f, 1.0f, 60.2f), 2);
   EXPECT_EQ(progress_text(*failed), "failed: not_settled (60.2 s)");
+  // The heartbeat's state, by which identify knows the result was applied.
+  hal::CanFrame heartbeat = protocol::encode_frame(2, protocol::MessageId::heartbeat, {1.0f});
+  EXPECT_EQ(heartbeat_state(heartbeat, 2), firmware::DriveState::idle);
+  EXPECT_FALSE(heartbeat_state(heartbeat, 3).has_value());
   // Before a run: "none" is neither running nor ended.
   const auto idle = decode_identify_progress(progress_frame(2, 6.0f, 0.0f, 0.0f, 0.0f), 2);
   EXPECT_FALSE(idle->running() || idle->ended());

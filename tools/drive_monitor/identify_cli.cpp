@@ -88,12 +88,33 @@ int run_identify(const IdentifyOptions& o) {
   });
   std::cout << '\n';
   if (!progress || !progress->ended()) {
-    return fail(g_stop != 0 ? "identify: stopped (the drive goes on; a disable aborts it)"
-                            : "identify: no end within " + seconds_text(o.timeout_s) + " s",
+    // The host leaves: a run that turns the motor must not go on unattended.
+    const bool sent = bus->try_send(session.encode({protocol::CommandKind::disable}));
+    const std::string why = g_stop != 0
+                                ? "identify: stopped"
+                                : "identify: no end within " + seconds_text(o.timeout_s) + " s";
+    return fail(why + (sent ? "; disable sent, which aborts the run"
+                            : "; disable could not be sent: the run goes on, disable the drive"),
                 kExitNoAnswer);
   }
   if (progress->step != 4) return fail("identify: " + progress_text(*progress), kExitRejected);
-  // The drive applies and saves the record outside its tick: a read waits while it is busy.
+  // Done: the drive builds its model from the result and saves it outside the tick, then goes
+  // idle; a record it refuses turns the step to failed (invalid_record). The progress frame
+  // follows the heartbeat of the same tick, so the first one after an idle heartbeat decides.
+  bool idle = false, decided = false;
+  receive_until(*bus, 5.0 * o.wait_s, [&](const hal::CanFrame& f) {
+    if (const auto state = heartbeat_state(f, node)) {
+      idle = *state == firmware::DriveState::idle;
+      return false;
+    }
+    const auto p = decode_identify_progress(f, node);
+    if (!p) return false;
+    progress = p;
+    decided = p->step == 5 || idle;
+    return decided;
+  });
+  if (!decided) return fail("identify: done, but the drive did not go idle on it", kExitNoAnswer);
+  if (progress->step != 4) return fail("identify: " + progress_text(*progress), kExitRejected);
   return read_record(session, o.node, o.can, o.motor_out);
 }
 

@@ -94,6 +94,12 @@ std::optional<IdentifyProgress> decode_identify_progress(const hal::CanFrame& fr
                           protocol::get_physical(frame.data, s[3])};
 }
 
+std::optional<firmware::DriveState> heartbeat_state(const hal::CanFrame& frame, uint8_t node_id) {
+  const protocol::Message& m = protocol::message(protocol::MessageId::heartbeat);
+  if (frame.id != protocol::can_id(node_id, m.id) || frame.length != m.length) return std::nullopt;
+  return static_cast<firmware::DriveState>(protocol::get_raw(frame.data, m.signals[0]));
+}
+
 std::string progress_text(const IdentifyProgress& p) {
   const auto& s = protocol::message(protocol::MessageId::identify_progress).signals;
   const char* step = protocol::value_name(s[0], p.step);

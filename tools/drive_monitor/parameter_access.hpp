@@ -6,6 +6,7 @@
 #include <string>
 #include <string_view>
 
+#include "firmware/drive_state.hpp"
 #include "firmware/parameters/motor_record.hpp"
 #include "firmware/protocol/commands.hpp"
 #include "hal/can_bus.hpp"
@@ -50,6 +51,8 @@ struct IdentifyProgress {
 /// The progress if `frame` is node `node_id`'s identify_progress.
 std::optional<IdentifyProgress> decode_identify_progress(const hal::CanFrame& frame,
                                                          uint8_t node_id);
+/// The drive state if `frame` is node `node_id`'s heartbeat.
+std::optional<firmware::DriveState> heartbeat_state(const hal::CanFrame& frame, uint8_t node_id);
 /// "accelerate 40 % (12.3 s)", or "done (14.1 s)", "failed: not_settled (60.2 s)".
 std::string progress_text(const IdentifyProgress& p);
 

@@ -29,11 +29,11 @@
 extern char** environ;
 
 #include "hal_sim/config_error.hpp"
+#include "hal_sim/drive/scenario_run.hpp"
+#include "hal_sim/drive/scripted_commands.hpp"
 #include "hal_sim/motor_file.hpp"
 #include "hal_sim/scenario.hpp"
 #include "tools/can_log/candump_log.hpp"
-#include "hal_sim/drive/scenario_run.hpp"
-#include "hal_sim/drive/scripted_commands.hpp"
 
 namespace {
 
@@ -94,9 +94,14 @@ const Column kColumns[] = {
 #undef IMD_COLUMN
 
 nlohmann::ordered_json motor_json(const imd::control::MotorParameters& m) {
-  return {{"Rs_Ohm", m.Rs_Ohm}, {"Ls_H", m.Ls_H},     {"Lm_H", m.Lm_H},
-          {"Rr_Ohm", m.Rr_Ohm}, {"Lr_H", m.Lr_H},     {"J_kgm2", m.J_kgm2},
-          {"pole_pairs", m.pole_pairs}, {"friction_Nms", m.friction_Nms}};
+  return {{"Rs_Ohm", m.Rs_Ohm},
+          {"Ls_H", m.Ls_H},
+          {"Lm_H", m.Lm_H},
+          {"Rr_Ohm", m.Rr_Ohm},
+          {"Lr_H", m.Lr_H},
+          {"J_kgm2", m.J_kgm2},
+          {"pole_pairs", m.pole_pairs},
+          {"friction_Nms", m.friction_Nms}};
 }
 
 /// A commissioning run's report: "identified" (the record's keys, and the quantities the
@@ -104,8 +109,10 @@ nlohmann::ordered_json motor_json(const imd::control::MotorParameters& m) {
 void commissioning_json(const imd::sim::CommissioningReport& c, nlohmann::ordered_json& out) {
   nlohmann::ordered_json steps = nlohmann::ordered_json::object();
   for (const auto& [name, seconds] : c.step_s) steps[name] = seconds;
-  out["identification"] = {{"ended", c.ended},    {"result", c.step},
-                           {"failure", c.failure}, {"steps_s", steps},
+  out["identification"] = {{"ended", c.ended},
+                           {"result", c.step},
+                           {"failure", c.failure},
+                           {"steps_s", steps},
                            {"total_s", c.total_s}};
   if (!c.identified) {
     out["identified"] = nullptr;
@@ -136,33 +143,34 @@ nlohmann::ordered_json summary_json(const imd::sim::Scenario& s, const imd::sim:
   for (int i = 0; i < imd::firmware::kStageCount; ++i) {
     stages[imd::firmware::kStageNames[i]] = r.stage_ns_mean[i];
   }
-  nlohmann::ordered_json result = {{"scenario", s.source},
-          {"controller", s.controller},
-          {"precision", s.precision},
-          {"motor", motor_json(s.motor)},  // what the controller was given
-          {"plant", motor_json(s.plant)},  // what it ran
-          {"settle_s", s.settle_s},
-          {"speed_rms_err_rad_s", r.speed_rms_err_rad_s},
-          {"speed_max_err_rad_s", r.speed_max_err_rad_s},
-          {"flux2_rms_err_Wb2", r.flux2_rms_err_Wb2},
-          {"flux2_max_err_Wb2", r.flux2_max_err_Wb2},
-          {"load_est_rms_err_Nm", r.load_est_rms_err_Nm},
-          {"torque_rms_err_Nm", r.torque_rms_err_Nm},
-          {"i_hold_rms_err_A", r.i_hold_rms_err_A},
-          {"i_peak_A", r.i_peak_A},
-          {"i_peak_total_A", r.i_peak_total_A},
-          {"i_max_A", std::isfinite(s.i_max_A) ? nlohmann::ordered_json(s.i_max_A)
-                                               : nlohmann::ordered_json(nullptr)},
-          {"saturated_fraction", r.saturated_fraction},
-          {"running_from_s", r.running_from_s},
-          {"ticks", r.ticks},
-          {"simulated_s", r.simulated_s},
-          {"wall_time_s", r.wall_time_s},
-          {"simulated_s_per_wall_s", r.wall_time_s > 0 ? r.simulated_s / r.wall_time_s : 0.0},
-          {"tick_exec_ns_mean", r.tick_exec_ns_mean},
-          {"tick_exec_ns_max", r.tick_exec_ns_max},
-          {"stage_ns", stages},
-          {"faults", faults}};
+  nlohmann::ordered_json result = {
+      {"scenario", s.source},
+      {"controller", s.controller},
+      {"precision", s.precision},
+      {"motor", motor_json(s.motor)},  // what the controller was given
+      {"plant", motor_json(s.plant)},  // what it ran
+      {"settle_s", s.settle_s},
+      {"speed_rms_err_rad_s", r.speed_rms_err_rad_s},
+      {"speed_max_err_rad_s", r.speed_max_err_rad_s},
+      {"flux2_rms_err_Wb2", r.flux2_rms_err_Wb2},
+      {"flux2_max_err_Wb2", r.flux2_max_err_Wb2},
+      {"load_est_rms_err_Nm", r.load_est_rms_err_Nm},
+      {"torque_rms_err_Nm", r.torque_rms_err_Nm},
+      {"i_hold_rms_err_A", r.i_hold_rms_err_A},
+      {"i_peak_A", r.i_peak_A},
+      {"i_peak_total_A", r.i_peak_total_A},
+      {"i_max_A", std::isfinite(s.i_max_A) ? nlohmann::ordered_json(s.i_max_A)
+                                           : nlohmann::ordered_json(nullptr)},
+      {"saturated_fraction", r.saturated_fraction},
+      {"running_from_s", r.running_from_s},
+      {"ticks", r.ticks},
+      {"simulated_s", r.simulated_s},
+      {"wall_time_s", r.wall_time_s},
+      {"simulated_s_per_wall_s", r.wall_time_s > 0 ? r.simulated_s / r.wall_time_s : 0.0},
+      {"tick_exec_ns_mean", r.tick_exec_ns_mean},
+      {"tick_exec_ns_max", r.tick_exec_ns_max},
+      {"stage_ns", stages},
+      {"faults", faults}};
   if (r.commissioning) commissioning_json(*r.commissioning, result);
   return result;
 }
@@ -222,12 +230,17 @@ int main(int argc, char** argv) {
 
   imd::sim::Scenario scenario;
   try {
-    scenario = imd::sim::load_scenario(scenario_path, overrides,
-                                       model_file ? std::optional<std::filesystem::path>(*model_file)
-                                                  : std::nullopt);
+    scenario = imd::sim::load_scenario(
+        scenario_path, overrides,
+        model_file ? std::optional<std::filesystem::path>(*model_file) : std::nullopt);
     if (!motor_out_path.empty() && !scenario.commissioning) {
       throw imd::sim::ConfigError(scenario_path +
                                   ": --motor-out needs a commissioning scenario ([nameplate])");
+    }
+    if (model_file && scenario.commissioning) {
+      throw imd::sim::ConfigError(scenario_path +
+                                  ": --motor-file: a commissioning scenario gives the drive no "
+                                  "motor (it identifies one)");
     }
     imd::sim::scripted_frames(scenario);  // [[can_commands]] against the protocol table
   } catch (const imd::sim::ConfigError& error) {
@@ -313,8 +326,12 @@ int main(int argc, char** argv) {
   if (!motor_out_path.empty()) {
     const auto& c = summary.commissioning;
     if (!c || !c->identified) {
-      std::cerr << "drive_sim: no motor identified (" << (c ? c->failure : "not run")
-                << "): " << motor_out_path << " not written\n";
+      const std::string why = !c || !c->ended
+                                  ? "the commissioning did not end within simulation.duration_s; "
+                                    "give it more with --duration-s"
+                                  : c->step + ", " + c->failure;
+      std::cerr << "drive_sim: no motor identified (" << why << "): " << motor_out_path
+                << " not written\n";
       return kExitNotIdentified;
     }
     const std::string motor_text = imd::sim::motor_file_text(
