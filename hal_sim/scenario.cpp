@@ -150,9 +150,10 @@ control::MotorParameters parse_plant_table(const toml::table& doc, const std::st
   const toml::table changes = plant != nullptr ? *plant->as_table() : toml::table{};
   for (auto&& [key, value] : changes) {
     if (!kMotorKeys.count(std::string(key.str())) && key.str() != "name") {
-      throw ConfigError(fmt::format("{}: unknown key plant.{} (a motor key: Rs_Ohm, Ls_H, Lm_H, "
-                                    "Rr_Ohm, Lr_H, J_kgm2, pole_pairs, friction_Nms)",
-                                    source, key.str()));
+      throw ConfigError(
+          fmt::format("{}: unknown key plant.{} (a motor key: Rs_Ohm, Ls_H, Lm_H, "
+                      "Rr_Ohm, Lr_H, J_kgm2, pole_pairs, friction_Nms)",
+                      source, key.str()));
     }
     completed.insert_or_assign(key, value);
   }
@@ -163,8 +164,7 @@ control::MotorParameters parse_plant_table(const toml::table& doc, const std::st
 
 }  // namespace
 
-Scenario load_scenario(const std::filesystem::path& path,
-                       const std::vector<std::string>& overrides,
+Scenario load_scenario(const std::filesystem::path& path, const std::vector<std::string>& overrides,
                        const std::optional<std::filesystem::path>& model_file) {
   toml::table doc = parse_toml_file(path);
   const std::string source = path.string();
@@ -175,20 +175,23 @@ Scenario load_scenario(const std::filesystem::path& path,
     doc.insert("motor", motor_table_of(path, *motor_file, "motor_file"));
     doc.erase("motor_file");
   }
+  // model_file: the controller's motor from the file, the plant stays the scenario's motor;
+  // before the overrides, so that motor.* changes the controller's and plant.* the plant's.
+  std::optional<toml::table> scenario_motor;
+  if (model_file) {
+    if (doc.get("motor") != nullptr) scenario_motor = *doc.get("motor")->as_table();
+    const toml::table model_doc = parse_toml_file(*model_file);
+    (void)parse_motor_table(model_doc, model_file->string());  // its own errors, its own name
+    doc.insert_or_assign("motor", *model_doc.get("motor")->as_table());
+  }
   for (const std::string& assignment : overrides) apply_override(doc, assignment, source);
   // [plant] motor_file: the simulated motor starts from that file instead of [motor].
-  std::optional<toml::table> plant_base;
+  std::optional<toml::table> plant_base = scenario_motor;
   if (toml::table* plant = doc["plant"].as_table()) {
     if (const toml::node* file = plant->get("motor_file")) {
       plant_base = motor_table_of(path, *file, "plant.motor_file");
       plant->erase("motor_file");
     }
-  }
-  if (model_file) {  // the controller's motor from the file; the plant stays the scenario's
-    if (!plant_base && doc.get("motor") != nullptr) plant_base = *doc.get("motor")->as_table();
-    const toml::table model_doc = parse_toml_file(*model_file);
-    (void)parse_motor_table(model_doc, model_file->string());  // its own errors, its own name
-    doc.insert_or_assign("motor", *model_doc.get("motor")->as_table());
   }
   // A commissioning run gives the drive no motor: without [motor], the plant's stands for it.
   if (doc.get("motor") == nullptr && plant_base && doc.get("nameplate") != nullptr) {
@@ -248,8 +251,9 @@ Scenario load_scenario(const std::filesystem::path& path,
   // follows a torque reference.
   // With command_source = "can" it comes only from CAN commands.
   if (r.present("nameplate") && s.command_source != "can") {
-    r.fail("drive.command_source", "a commissioning run ([nameplate]) needs command_source = "
-                                   "\"can\": the nameplate and the identify command go over CAN");
+    r.fail("drive.command_source",
+           "a commissioning run ([nameplate]) needs command_source = "
+           "\"can\": the nameplate and the identify command go over CAN");
   }
   if (s.command_source == "can") {
     if (r.present("reference.speed")) {
@@ -289,13 +293,13 @@ Scenario load_scenario(const std::filesystem::path& path,
   s.limit_voltage = r.boolean("inverter.limit_voltage", true);
   s.inverter.dead_time_s = r.non_negative("inverter.dead_time_s", 0.0);
   if (s.inverter.dead_time_s >= 0.1 * s.sample_period_s) {  // a 10 % duty loss is no inverter
-    r.fail("inverter.dead_time_s", fmt::format("= {}: must be below 0.1 * drive.sample_period_s",
-                                               s.inverter.dead_time_s));
+    r.fail("inverter.dead_time_s",
+           fmt::format("= {}: must be below 0.1 * drive.sample_period_s", s.inverter.dead_time_s));
   }
   s.inverter.device_drop_V = r.non_negative("inverter.device_drop_V", 0.0);
   if (s.inverter.device_drop_V >= 0.1 * s.v_bus_V) {
-    r.fail("inverter.device_drop_V", fmt::format("= {}: must be below 0.1 * inverter.v_bus_V",
-                                                 s.inverter.device_drop_V));
+    r.fail("inverter.device_drop_V",
+           fmt::format("= {}: must be below 0.1 * inverter.v_bus_V", s.inverter.device_drop_V));
   }
   s.dead_time_compensation = r.boolean("drive.dead_time_compensation", true);
 

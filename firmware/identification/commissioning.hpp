@@ -54,7 +54,7 @@ class Commissioning {
     }
   }
   /// The protocol's identify_failure code (7: done, the rotor did not turn, mechanics kept;
-  /// 8 wrong_direction, 9 overspeed, 10 not_at_rest).
+  /// 8 wrong_direction, 9 overspeed, 10 not_at_rest, 11 stalled).
   uint8_t failure_code() const noexcept {
     if (!inertia_) return static_cast<uint8_t>(standstill_.failure());
     switch (inertia_->outcome()) {
@@ -70,6 +70,8 @@ class Commissioning {
         return 9;
       case InertiaOutcome::not_at_rest:
         return 10;
+      case InertiaOutcome::stalled:
+        return 11;
       case InertiaOutcome::running:
       case InertiaOutcome::measured:
         break;

@@ -143,14 +143,31 @@ control::Vec2<T> InertiaIdentifier<T>::step(const Vec2& i_A,
       if (step_ == InertiaStep::accelerate) {
         i_q_ref_A = i_q_A_;
         const bool at_speed = omega_block_rad_s_ >= omega_test_rad_s_;
+        if (ticks_ == max_accelerate_ticks_ / 2) omega_half_time_rad_s_ = omega_block_rad_s_;
         if (at_speed) {
           take_row(0);
           accelerate_ticks_ = ticks_;
           omega_coast_from_rad_s_ = omega_block_rad_s_;
           enter(InertiaStep::coast);
         } else if (ticks_ >= max_accelerate_ticks_) {
-          accelerate_ticks_ = ticks_;       // what the brake may take
-          stop(InertiaOutcome::no_motion);  // too heavy or too loaded for this test
+          // Out of time: a locked shaft (under a radian turned), a speed that stopped growing
+          // (a load or friction above the test torque, or a field not oriented: wrong pole
+          // pairs or encoder resolution), or a heavy rotor still accelerating: measured if it
+          // got far enough, else too heavy for the test.
+          accelerate_ticks_ = ticks_;  // what the brake may take
+          const bool moved = T(counts_) * rad_per_count_ > T(1);
+          const bool still_accelerating = omega_block_rad_s_ > T(1.5) * omega_half_time_rad_s_;
+          if (!moved) {
+            stop(InertiaOutcome::no_motion);
+          } else if (!still_accelerating) {
+            stop(InertiaOutcome::stalled);
+          } else if (omega_block_rad_s_ >= T(0.2) * omega_test_rad_s_) {
+            take_row(0);
+            omega_coast_from_rad_s_ = omega_block_rad_s_;
+            enter(InertiaStep::coast);
+          } else {
+            stop(InertiaOutcome::no_motion);
+          }
         }
       } else {
         // As long as the acceleration took (at least 0.1 s); shorter if friction halves the

@@ -29,6 +29,7 @@ enum class InertiaOutcome : uint8_t {
   wrong_direction,  ///< the encoder counts against the phase sequence (swap two phases or A/B)
   overspeed,        ///< the speed passed twice the test speed: the field is not oriented
   not_at_rest,      ///< turning when the step began, or not braked to rest in time
+  stalled,          ///< the speed settled below the test speed (load, or a field not oriented)
 };
 
 /// What the rotating step is planned from besides the standstill result (double, outside the
@@ -135,6 +136,7 @@ class InertiaIdentifier {
   int32_t block_counts_ = 0;
   uint32_t block_ticks_ = 0;
   T omega_block_rad_s_ = T(0), omega_brake_from_rad_s_ = T(0), omega_coast_from_rad_s_ = T(0);
+  T omega_half_time_rad_s_ = T(0);  ///< at half the acceleration's time limit
   // The integrals from rest: counts (exact), Int theta, Int Te, Int Int Te.
   int32_t counts_ = 0;
   CompensatedSum<T> int_theta_, int_torque_, int2_torque_;

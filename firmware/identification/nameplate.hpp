@@ -22,6 +22,7 @@ struct IdentificationPlan {
   double kp_Ohm = 0.0, ki_Ohm_per_s = 0.0;  ///< the current loop's PI
   double v_limit_V = 0.0;                   ///< the loop's output limit (linear SVPWM range)
   double hf_voltage_V = 0.0;                ///< square-wave amplitude of the sigma Ls step
+  double hf_ripple_A = 0.0;  ///< the ripple it aims at (the amplitude is cut to it once probed)
   int hf_half_period_ticks = 2;
   int hf_ticks = 2000;        ///< length of the square-wave injection
   int window_ticks = 100;     ///< the settling detector's averaging window (10 ms)
@@ -32,19 +33,23 @@ struct IdentificationPlan {
 /// The rules (docs/identification.md, "Test levels and gains"):
 /// * base impedance Z_b = V_LL / (sqrt(3) I_rated); the transient inductance of a standard
 ///   motor is 0.1..0.2 per unit: sigma Ls ~ 0.15 Z_b / omega_rated;
-/// * DC levels at 0.3 and 0.6 of the rated peak current (never above 0.9 of the board's
-///   limit): high enough that no phase current comes near zero, where the dead time's error
+/// * DC levels at 0.3 and 0.6 of the rated peak current (never above 0.75 of the board's
+///   limit, which leaves room for the square wave's ripple): high enough that no phase current comes near zero, where the dead time's error
 ///   changes sign, and low enough not to saturate the iron;
 /// * the PI's crossover omega_c = 2 pi 50 Hz on sigma Ls (Kp = sigma Ls omega_c; Ki = Kp
 ///   omega_c / 5): far below the sample rate, so a guess three times off stays stable, and slow
 ///   enough that the ADC noise barely reaches the voltage the estimates use;
-/// * the square wave of the sigma Ls step makes a current ripple of 0.2 of the high level.
+/// * the square wave of the sigma Ls step makes a current ripple of 0.2 of the high level; its
+///   first two periods at a quarter of the amplitude probe sigma Ls, and the amplitude is cut
+///   to what gives that ripple on the probed value (a motor of lower sigma Ls than the guess
+///   would otherwise take the current past the board's limit).
 inline IdentificationPlan plan_identification(const Nameplate& n, double i_max_A, double v_bus_V,
                                               double period_s) {
   IdentificationPlan p;
   p.period_s = period_s;
   const double i_rated_peak_A = std::sqrt(2.0) * n.rated_current_A;
-  const double i_top_A = std::min(0.6 * i_rated_peak_A, 0.9 * i_max_A);
+  // The square wave rides 0.2 I2 above the level: its peak stays within 0.9 of the limit.
+  const double i_top_A = std::min(0.6 * i_rated_peak_A, 0.75 * i_max_A);
   p.i_high_A = i_top_A;
   p.i_low_A = 0.5 * i_top_A;
   const double z_base_Ohm = n.rated_voltage_V / (std::sqrt(3.0) * n.rated_current_A);
@@ -55,6 +60,7 @@ inline IdentificationPlan plan_identification(const Nameplate& n, double i_max_A
   p.ki_Ohm_per_s = p.kp_Ohm * omega_c_rad_s / 5.0;
   p.v_limit_V = 0.95 * v_bus_V / std::sqrt(3.0);
   const double ripple_A = 0.2 * p.i_high_A;
+  p.hf_ripple_A = ripple_A;
   p.hf_voltage_V = std::min(ripple_A * p.sigma_Ls_guess_H / (p.hf_half_period_ticks * period_s),
                             0.3 * p.v_limit_V);
   return p;

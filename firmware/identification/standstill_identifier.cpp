@@ -109,8 +109,18 @@ control::Vec2<T> StandstillIdentifier<T>::step(const Vec2& i_A) noexcept {
         sdi_.add(delta_acting_V_ * di);
       }
       delta_acting_V_ = delta_written_V_;
+      // Two periods at a quarter of the amplitude probe sigma Ls; then the amplitude is cut to
+      // the planned ripple on the probed value, and the sums start again.
+      const auto probe_ticks = uint32_t(4 * hf_half_);
+      if (ticks_ == probe_ticks + 1 && sdi_.value() > T(0)) {
+        const T sigma_Ls_H = period_s_ * sdd_.value() / sdi_.value();
+        hf_V_ = std::min(hf_V_, hf_ripple_A_ * sigma_Ls_H / (T(hf_half_) * period_s_));
+        sdd_.reset();
+        sdi_.reset();
+      }
+      const T amplitude_V = ticks_ <= probe_ticks ? T(0.25) * hf_V_ : hf_V_;
       const int half = int((ticks_ - 1) / uint32_t(hf_half_));
-      delta_written_V_ = (half % 2 == 0 ? T(1) : T(-1)) * hf_V_;
+      delta_written_V_ = (half % 2 == 0 ? T(1) : T(-1)) * amplitude_V;
       if (int(ticks_) > hf_ticks_) delta_written_V_ = T(0);
       u = Vec2(hf_bias_V_ + delta_written_V_, integral_V_.y());
       if (int(ticks_) > hf_ticks_ + 2) {  // the last square-wave value has acted

@@ -52,6 +52,7 @@ class StandstillIdentifier {
         ki_T_(T(plan.ki_Ohm_per_s * plan.period_s)),
         v_limit_V_(T(plan.v_limit_V)),
         hf_V_(T(plan.hf_voltage_V)),
+        hf_ripple_A_(T(plan.hf_ripple_A)),
         hf_half_(plan.hf_half_period_ticks),
         hf_ticks_(plan.hf_ticks),
         window_ticks_(plan.window_ticks),
@@ -90,7 +91,7 @@ class StandstillIdentifier {
   }
   void finish() noexcept;
 
-  T period_s_, i_low_A_, i_high_A_, kp_, ki_T_, v_limit_V_, hf_V_;
+  T period_s_, i_low_A_, i_high_A_, kp_, ki_T_, v_limit_V_, hf_V_, hf_ripple_A_;
   int hf_half_, hf_ticks_, window_ticks_;
   uint32_t max_level_ticks_, ramp_ticks_;
 

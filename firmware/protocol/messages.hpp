@@ -130,7 +130,7 @@ inline constexpr ValueName kIdentifyFailureValues[] = {
     {0, "none"},        {1, "not_settled"}, {2, "voltage_limit"}, {3, "implausible"},
     {4, "no_nameplate"}, {5, "aborted"},    {6, "invalid_record"},
     {7, "no_motion"},  // done: the rotor did not turn, the mechanics were kept
-    {8, "wrong_direction"}, {9, "overspeed"}, {10, "not_at_rest"},
+    {8, "wrong_direction"}, {9, "overspeed"}, {10, "not_at_rest"}, {11, "stalled"},
 };
 inline constexpr ValueName kParameterStatusValues[] = {
     {0, "ok"},         {1, "not_idle"},  {2, "unknown_field"}, {3, "not_finite"},

@@ -24,6 +24,9 @@ struct CommissioningReport {
   std::vector<std::pair<std::string, double>> step_s;  ///< simulated time per step, in order
   double total_s = 0.0;
   std::optional<control::MotorParameters> identified;
+  /// Whether J and the friction in `identified` were measured by the rotating step; if not,
+  /// they are the record's before, or on a new board the catalogue inertia and no friction.
+  bool mechanics_measured = false;
 };
 
 class CommissioningWatch {
@@ -55,17 +58,31 @@ class CommissioningWatch {
     report_.step = name(firmware::protocol::kIdentifyProgressSignals[0], status.identify_step);
     report_.failure =
         name(firmware::protocol::kIdentifyProgressSignals[2], status.identify_failure);
+    finish();
+    if (report_.done) report_.identified = drive.motor();
+    return true;
+  }
+
+  /// The time of each step so far (a run cut short reports what it did).
+  void finish() {
+    report_.step_s.clear();
+    report_.total_s = 0.0;
     for (const uint8_t step : order_) {
       report_.step_s.emplace_back(name(firmware::protocol::kIdentifyProgressSignals[0], step),
                                   double(ticks_[step]) * period_s_);
       report_.total_s += double(ticks_[step]) * period_s_;
     }
-    if (report_.done) report_.identified = drive.motor();
-    return true;
+  }
+
+  /// Marks the mechanics measured when the rotating step ran to its end.
+  void mechanics_measured(bool rotated) {
+    report_.mechanics_measured =
+        report_.done && rotated && report_.failure == "none" && report_.identified.has_value();
   }
 
   /// Whether a commissioning was seen at all, and how it ended.
   const CommissioningReport& report() const noexcept { return report_; }
+  CommissioningReport& report() noexcept { return report_; }
 
  private:
   static std::string name(const firmware::protocol::Signal& signal, int64_t raw) {

@@ -13,7 +13,7 @@
 namespace imd::sim {
 
 struct EmbeddedScenario {
-  const char* name = "";  ///< the scenario file's stem, e.g. "seed000_realistic"
+  const char* name = "";           ///< the scenario file's stem, e.g. "seed000_realistic"
   control::MotorParameters motor;  ///< the controller's
   control::MotorParameters plant;  ///< the simulated motor's
   SimBoardConfig board;

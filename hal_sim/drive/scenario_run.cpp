@@ -121,7 +121,11 @@ Summary run(const Scenario& s, const RunCallbacks& callbacks) {
     }
   }
   if (!diverged && !commissioning.report().ended) summary.ticks = ticks;
-  if (s.commissioning) summary.commissioning = commissioning.report();
+  if (s.commissioning) {
+    if (!commissioning.report().ended) commissioning.finish();
+    commissioning.mechanics_measured(s.commissioning->rotate);
+    summary.commissioning = commissioning.report();
+  }
   summary.simulated_s = double(summary.ticks) * s.sample_period_s;
   summary.wall_time_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();

@@ -194,5 +194,18 @@ TEST(InertiaIdentification, AShaftDrivenByItsLoadIsLeftWithThePwmOff) {
   EXPECT_FALSE(rig.board.pwm().enabled());
 }
 
+// A nameplate with the wrong pole-pair count (1 for a six-pole motor): the field cannot be
+// oriented, the speed settles far below the test speed. Named, not taken for a locked shaft.
+TEST(InertiaIdentification, AWrongPolePairCountStallsAndIsNamed) {
+  const Case c{"six_pole_7kW", {400.0, 14.0, 50.0, 1}, 540.0, 40.0, 50.0, 0.05, 0.1, 1.5e-6, 1.2};
+  const sim::SimBoardConfig b = board_for(c);
+  Rig<float> rig(motor_named(c.motor), b,
+                 plan_identification(c.nameplate, c.i_max_A, c.v_bus_V, b.period_s),
+                 plan_inertia_test(c.nameplate, c.i_max_A, c.v_bus_V, b.period_s, b.encoder_cpr));
+  run(rig);
+  EXPECT_FALSE(rig.commissioning.succeeded());
+  EXPECT_EQ(rig.commissioning.failure_code(), 11);  // stalled
+}
+
 }  // namespace
 }  // namespace imd::firmware

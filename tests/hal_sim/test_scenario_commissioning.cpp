@@ -80,9 +80,17 @@ TEST(ScenarioCommissioning, AMotorFileForTheControllerLeavesThePlantTheScenarios
   std::ofstream(file) << motor_file_text(model, "a guess", "");
   const Scenario s =
       load_scenario(test::source_path("hal_sim/scenarios/seed000_realistic.toml"), {}, file);
-  std::filesystem::remove(file);
   EXPECT_EQ(s.motor.Rr_Ohm, 7.0);
   EXPECT_EQ(s.plant.Rr_Ohm, 10.1);
+  // motor.* then changes the controller's motor, plant.* the plant.
+  const Scenario changed =
+      load_scenario(test::source_path("hal_sim/scenarios/seed000_realistic.toml"),
+                    {"motor.Rs_Ohm=20", "plant.Lm_H=0.38"}, file);
+  EXPECT_EQ(changed.motor.Rs_Ohm, 20.0);
+  EXPECT_EQ(changed.plant.Rs_Ohm, 14.0);
+  EXPECT_EQ(changed.plant.Lm_H, 0.38);
+  EXPECT_EQ(changed.motor.Rr_Ohm, 7.0);
+  std::filesystem::remove(file);
   // A model file that is not a valid motor is refused with its own name.
   const std::filesystem::path bad = test::source_path("tests/data/motors/bad_negative_Rs.toml");
   try {

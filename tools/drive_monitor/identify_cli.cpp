@@ -17,15 +17,18 @@ namespace protocol = firmware::protocol;
 CLI::App* add_identify_command(CLI::App& app, IdentifyOptions& o) {
   CLI::App* c = app.add_subcommand(
       "identify",
-      "Commission the motor: identify its parameters from the nameplate the drive "
-      "holds, show the progress, read back the result");
+      "Commission the motor: identify its parameters from the nameplate the drive holds (write "
+      "it first: parameters --set rated_voltage_V=... rated_current_A=... rated_frequency_Hz=... "
+      "pole_pairs=...), show the progress, read back the result. The drive must be idle or "
+      "unconfigured with its enable input on; Ctrl-C sends a disable, which aborts the run");
   c->add_option("--can", o.can, "CAN interface (SocketCAN), e.g. can0")->required();
   c->add_option("--node", o.node, "Node id of the drive")
       ->check(CLI::Range(0, protocol::kMaxNodeId))
       ->required();
   c->add_flag("--rotate", o.rotate,
               "After the standstill steps, turn the motor to measure inertia and friction (the "
-              "shaft must be free to turn); without it the drive keeps the mechanics it has");
+              "shaft must be free to turn); without it the drive keeps the mechanics its "
+              "record has, or on a new drive guesses J from the nameplate");
   c->add_option("--motor-out", o.motor_out, "Write the identified record as a motor file");
   c->add_option("--timeout-s", o.timeout_s, "Give up waiting for the end after this long")
       ->check(kSeconds)
@@ -115,6 +118,10 @@ int run_identify(const IdentifyOptions& o) {
   });
   if (!decided) return fail("identify: done, but the drive did not go idle on it", kExitNoAnswer);
   if (progress->step != 4) return fail("identify: " + progress_text(*progress), kExitRejected);
+  if (progress->failure == 7) {
+    std::cerr << "drive_monitor: warning: the rotor did not turn in the rotating step: inertia "
+                 "and friction are not measured\n";
+  }
   return read_record(session, o.node, o.can, o.motor_out);
 }
 

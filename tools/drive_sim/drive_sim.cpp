@@ -109,11 +109,10 @@ nlohmann::ordered_json motor_json(const imd::control::MotorParameters& m) {
 void commissioning_json(const imd::sim::CommissioningReport& c, nlohmann::ordered_json& out) {
   nlohmann::ordered_json steps = nlohmann::ordered_json::object();
   for (const auto& [name, seconds] : c.step_s) steps[name] = seconds;
-  out["identification"] = {{"ended", c.ended},
-                           {"result", c.step},
-                           {"failure", c.failure},
-                           {"steps_s", steps},
-                           {"total_s", c.total_s}};
+  out["identification"] = {
+      {"ended", c.ended},     {"result", c.step},
+      {"failure", c.failure}, {"steps_s", steps},
+      {"total_s", c.total_s}, {"mechanics", c.mechanics_measured ? "measured" : "not measured"}};
   if (!c.identified) {
     out["identified"] = nullptr;
     return;
@@ -173,6 +172,47 @@ nlohmann::ordered_json summary_json(const imd::sim::Scenario& s, const imd::sim:
       {"faults", faults}};
   if (r.commissioning) commissioning_json(*r.commissioning, result);
   return result;
+}
+
+/// A commissioning run's outcome on standard error, and its motor file: 0, or the exit code.
+int report_commissioning(const imd::sim::Scenario& s, const imd::sim::Summary& r,
+                         const std::string& motor_out_path,
+                         const std::vector<std::string>& overrides) {
+  const auto& c = r.commissioning;
+  if (!c || !c->identified) {
+    std::string why = !c || !c->ended ? "the commissioning did not end within "
+                                        "simulation.duration_s; give it more with --duration-s"
+                                      : c->step + ", " + c->failure;
+    if (!r.faults.empty()) why += "; fault " + r.faults.front().code;
+    std::cerr << "drive_sim: no motor identified (" << why << ")"
+              << (motor_out_path.empty() ? "" : ": " + motor_out_path + " not written") << '\n';
+    return kExitNotIdentified;
+  }
+  const imd::sim::CommissioningSettings& n = *s.commissioning;
+  std::string mechanics = "J and friction measured by the rotating step.";
+  if (!c->mechanics_measured) {
+    mechanics = c->failure == "no_motion"
+                    ? "J and friction NOT measured: the rotor did not reach the test speed; J "
+                      "is the catalogue rule's guess (docs/identification.md)."
+                    : "J and friction NOT measured (standstill only): J is the catalogue rule's "
+                      "guess (docs/identification.md); the speed loop's gains follow it.";
+    std::cerr << "drive_sim: warning: " << mechanics << '\n';
+  }
+  if (motor_out_path.empty()) return 0;
+  std::string settings;
+  for (const std::string& o : overrides) settings += " --set " + o;
+  const std::string text = imd::sim::motor_file_text(
+      *c->identified, "identified by commissioning",
+      fmt::format("Identified by drive_sim {}{}\n(nameplate {} V, {} A, {} Hz, pole pairs {}).\n"
+                  "Lr = Ls by the convention of equal leakages (docs/identification.md).\n{}",
+                  s.source, settings, n.rated_voltage_V, n.rated_current_A, n.rated_frequency_Hz,
+                  n.pole_pairs, mechanics));
+  std::FILE* file = std::fopen(motor_out_path.c_str(), "w");
+  if (file == nullptr || std::fputs(text.c_str(), file) < 0 || std::fclose(file) != 0) {
+    std::cerr << "drive_sim: cannot write " << motor_out_path << '\n';
+    return kExitOutputFailed;
+  }
+  return 0;
 }
 
 /// The plot script for the scenario's controller: paper 000's figures or paper 001's.
@@ -323,33 +363,9 @@ int main(int argc, char** argv) {
       return kExitOutputFailed;
     }
   }
-  if (!motor_out_path.empty()) {
-    const auto& c = summary.commissioning;
-    if (!c || !c->identified) {
-      const std::string why = !c || !c->ended
-                                  ? "the commissioning did not end within simulation.duration_s; "
-                                    "give it more with --duration-s"
-                                  : c->step + ", " + c->failure;
-      std::cerr << "drive_sim: no motor identified (" << why << "): " << motor_out_path
-                << " not written\n";
-      return kExitNotIdentified;
-    }
-    const std::string motor_text = imd::sim::motor_file_text(
-        *c->identified, "identified by commissioning",
-        fmt::format("Identified by drive_sim {} (nameplate {} V, {} A, {} Hz, {} pole pairs).\n"
-                    "Lr = Ls by the convention of equal leakages (docs/identification.md).",
-                    scenario.source, scenario.commissioning->rated_voltage_V,
-                    scenario.commissioning->rated_current_A,
-                    scenario.commissioning->rated_frequency_Hz,
-                    scenario.commissioning->pole_pairs));
-    std::FILE* file = std::fopen(motor_out_path.c_str(), "w");
-    if (file == nullptr || std::fputs(motor_text.c_str(), file) < 0 || std::fclose(file) != 0) {
-      std::cerr << "drive_sim: cannot write " << motor_out_path << '\n';
-      return kExitOutputFailed;
-    }
-  }
-  if (scenario.commissioning && !(summary.commissioning && summary.commissioning->identified)) {
-    return kExitNotIdentified;
+  if (scenario.commissioning) {
+    const int status = report_commissioning(scenario, summary, motor_out_path, overrides);
+    if (status != 0) return status;
   }
   if (!plot_path.empty()) {
     const int status = run_program({"/usr/bin/python3", plot_script(scenario), csv_path, "--out",
