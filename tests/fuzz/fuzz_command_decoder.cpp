@@ -50,6 +50,8 @@ bool value_in_range(const protocol::Command& c, const protocol::CommandLimits& l
              c.value <= float(protocol::kFastTelemetryMaxHz);
     case CommandKind::parameter_access:  // any float: the drive judges it and answers why
       return static_cast<int>(c.op) < protocol::kParameterOpCount;
+    case CommandKind::identify:  // rotate: 0 standstill only, 1 also the rotating step
+      return c.value == 0.0f || c.value == 1.0f;
     default:
       return c.value == 0.0f;
   }
