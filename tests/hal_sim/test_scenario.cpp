@@ -120,33 +120,6 @@ TEST(Scenario, MotorFileAndMotorTableTogetherAreRejected) {
   EXPECT_NE(error_of(path.string(), {}).find("missing.toml: cannot open file"), std::string::npos);
 }
 
-TEST(Scenario, ThePlantIsTheMotorUnlessPlantChangesIt) {
-  const Scenario same = load_scenario(kPaper);
-  EXPECT_EQ(same.plant.Rr_Ohm, same.motor.Rr_Ohm);
-  EXPECT_EQ(same.plant.Lm_H, same.motor.Lm_H);
-  EXPECT_EQ(same.plant.pole_pairs, same.motor.pole_pairs);
-  // A cold rotor in the controller, a hot one in the simulation: only the plant changes.
-  const Scenario hot = load_scenario(kPaper, {"plant.Rr_Ohm=15.15", "plant.J_kgm2=0.02"});
-  EXPECT_EQ(hot.motor.Rr_Ohm, 10.1);
-  EXPECT_EQ(hot.plant.Rr_Ohm, 15.15);
-  EXPECT_EQ(hot.motor.J_kgm2, 0.01);
-  EXPECT_EQ(hot.plant.J_kgm2, 0.02);
-  EXPECT_EQ(hot.plant.Ls_H, hot.motor.Ls_H);  // the keys [plant] does not name are [motor]'s
-  // A change of [motor] reaches the plant too when [plant] does not name the key.
-  const Scenario both = load_scenario(kPaper, {"motor.Rs_Ohm=3.2", "plant.Rr_Ohm=5"});
-  EXPECT_EQ(both.plant.Rs_Ohm, 3.2);
-}
-
-TEST(Scenario, BadPlantKeysAreRejectedWithTheirName) {
-  EXPECT_NE(error_of(kPaper, {"plant.Rx_Ohm=3"}).find("unknown key plant.Rx_Ohm"),
-            std::string::npos);
-  EXPECT_NE(error_of(kPaper, {"plant.Rr_Ohm=-1"}).find("plant.Rr_Ohm = -1"), std::string::npos);
-  EXPECT_NE(error_of(kPaper, {"plant.Lm_H=0.5"}).find("plant.Lm_H = 0.5: must satisfy"),
-            std::string::npos);
-  EXPECT_NE(error_of(kPaper, {"plant.pole_pairs=1.5"}).find("plant.pole_pairs must be an integer"),
-            std::string::npos);
-}
-
 /// A scenario in a scratch directory: the paper's motor, `body`, and the flux reference (with a
 /// speed reference unless `with_speed` is false). Top-level keys in `body` come first.
 std::string write_scenario(const std::string& name, const std::string& body,

@@ -1,5 +1,6 @@
-// Commissioning scenarios ([plant] motor_file, [nameplate], [identify]) and a controller given
-// another motor file than the plant's: what loads, and bad input named by its key.
+// The plant apart from the model ([plant], [plant] motor_file, a controller given another
+// motor file than the plant's) and commissioning scenarios ([nameplate], [identify]): what
+// loads, and bad input named by its key.
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -18,14 +19,46 @@ namespace imd::sim {
 namespace {
 
 const std::string kIdentify = test::source_path("hal_sim/scenarios/identify.toml");
+const std::string kPaper = test::source_path("hal_sim/scenarios/seed000_paper.toml");
 
-std::string error_of(const std::vector<std::string>& overrides) {
+std::string error_of(const std::string& path, const std::vector<std::string>& overrides) {
   try {
-    load_scenario(kIdentify, overrides);
+    load_scenario(path, overrides);
   } catch (const ConfigError& error) {
     return error.what();
   }
   return "(no error)";
+}
+
+std::string error_of(const std::vector<std::string>& overrides) {
+  return error_of(kIdentify, overrides);
+}
+
+TEST(Scenario, ThePlantIsTheMotorUnlessPlantChangesIt) {
+  const Scenario same = load_scenario(kPaper);
+  EXPECT_EQ(same.plant.Rr_Ohm, same.motor.Rr_Ohm);
+  EXPECT_EQ(same.plant.Lm_H, same.motor.Lm_H);
+  EXPECT_EQ(same.plant.pole_pairs, same.motor.pole_pairs);
+  // A cold rotor in the controller, a hot one in the simulation: only the plant changes.
+  const Scenario hot = load_scenario(kPaper, {"plant.Rr_Ohm=15.15", "plant.J_kgm2=0.02"});
+  EXPECT_EQ(hot.motor.Rr_Ohm, 10.1);
+  EXPECT_EQ(hot.plant.Rr_Ohm, 15.15);
+  EXPECT_EQ(hot.motor.J_kgm2, 0.01);
+  EXPECT_EQ(hot.plant.J_kgm2, 0.02);
+  EXPECT_EQ(hot.plant.Ls_H, hot.motor.Ls_H);  // the keys [plant] does not name are [motor]'s
+  // A change of [motor] reaches the plant too when [plant] does not name the key.
+  const Scenario both = load_scenario(kPaper, {"motor.Rs_Ohm=3.2", "plant.Rr_Ohm=5"});
+  EXPECT_EQ(both.plant.Rs_Ohm, 3.2);
+}
+
+TEST(Scenario, BadPlantKeysAreRejectedWithTheirName) {
+  EXPECT_NE(error_of(kPaper, {"plant.Rx_Ohm=3"}).find("unknown key plant.Rx_Ohm"),
+            std::string::npos);
+  EXPECT_NE(error_of(kPaper, {"plant.Rr_Ohm=-1"}).find("plant.Rr_Ohm = -1"), std::string::npos);
+  EXPECT_NE(error_of(kPaper, {"plant.Lm_H=0.5"}).find("plant.Lm_H = 0.5: must satisfy"),
+            std::string::npos);
+  EXPECT_NE(error_of(kPaper, {"plant.pole_pairs=1.5"}).find("plant.pole_pairs must be an integer"),
+            std::string::npos);
 }
 
 TEST(ScenarioCommissioning, TheNameplateBecomesCanWritesAndTheIdentifyCommand) {
