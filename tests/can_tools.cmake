@@ -2,6 +2,8 @@
 # Test names contain can_log, socketcan or monitor; all are in the unit tier.
 imd_add_test(test_can_log unit LIBRARIES imd_can_log SOURCES tools/test_can_log.cpp)
 imd_add_test(test_drive_monitor unit LIBRARIES imd_drive_monitor SOURCES tools/test_drive_monitor.cpp)
+imd_add_test(test_drive_monitor_repeat unit LIBRARIES imd_drive_monitor
+             SOURCES tools/test_drive_monitor_repeat.cpp)
 imd_add_test(test_drive_monitor_parameters unit LIBRARIES imd_drive_monitor
              SOURCES tools/test_drive_monitor_parameters.cpp)
 
