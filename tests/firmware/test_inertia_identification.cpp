@@ -17,16 +17,14 @@
 #include "firmware/identification/inertia_plan.hpp"
 #include "firmware/stages/sense.hpp"
 #include "hal_sim/sim_board.hpp"
+#include "identification_cases.hpp"
 #include "test_motors.hpp"
 
 namespace imd::firmware {
 namespace {
 
-struct Case {
-  const char* motor;
-  Nameplate nameplate;
-  double v_bus_V, i_max_A, adc_full_scale_A, adc_noise_A, adc_offset_A, dead_time_s, drop_V;
-};
+using test_cases::Case;
+using test_cases::motor_named;
 
 template <typename T>
 struct Rig final : hal::TickHandler {
@@ -57,25 +55,8 @@ struct Rig final : hal::TickHandler {
   }
 };
 
-sim::SimBoardConfig board_for(const Case& c) {
-  sim::SimBoardConfig b;
-  b.v_bus_V = c.v_bus_V;
-  b.adc.full_scale_A = c.adc_full_scale_A;
-  b.adc.noise_A = c.adc_noise_A;
-  b.adc.offset_A = {c.adc_offset_A, -c.adc_offset_A, 0.5 * c.adc_offset_A};
-  b.adc.bus_full_scale_V = 2.0 * c.v_bus_V;
-  b.inverter.dead_time_s = c.dead_time_s;
-  b.inverter.device_drop_V = c.drop_V;
-  b.encoder_cpr = 4096;
-  return b;
-}
-
-control::MotorParameters motor_named(const char* name) {
-  for (const auto& m : test::test_motors()) {
-    if (m.name == name) return m.parameters;
-  }
-  ADD_FAILURE() << "no test motor " << name;
-  return {};
+sim::SimBoardConfig rotating_board(const Case& c) {
+  return test_cases::board_for(c, 4096);
 }
 
 template <typename T>
@@ -92,7 +73,7 @@ class InertiaIdentification : public ::testing::TestWithParam<Case> {};
 template <typename T>
 void identify_and_check(const Case& c, const char* precision) {
   const control::MotorParameters truth = motor_named(c.motor);
-  const sim::SimBoardConfig b = board_for(c);
+  const sim::SimBoardConfig b = rotating_board(c);
   Rig<T> rig(truth, b, plan_identification(c.nameplate, c.i_max_A, c.v_bus_V, b.period_s),
              plan_inertia_test(c.nameplate, c.i_max_A, c.v_bus_V, b.period_s, b.encoder_cpr));
   run(rig);
@@ -126,23 +107,19 @@ TEST_P(InertiaIdentification, InSinglePrecisionToo) {
   identify_and_check<float>(GetParam(), "float");
 }
 
-// The boards of test_standstill_identification.cpp.
-INSTANTIATE_TEST_SUITE_P(
-    Motors, InertiaIdentification,
-    ::testing::Values(
-        Case{"seed000", {220.0, 2.5, 50.0, 1}, 311.0, 6.0, 10.0, 0.01, 0.02, 1e-6, 1.0},
-        Case{"seed001", {400.0, 70.0, 50.0, 2}, 540.0, 150.0, 250.0, 0.5, 0.5, 2e-6, 1.5},
-        Case{"small_4pole_750W", {400.0, 1.9, 50.0, 2}, 540.0, 6.0, 10.0, 0.01, 0.02, 1e-6, 1.0},
-        Case{"six_pole_7kW", {400.0, 14.0, 50.0, 3}, 540.0, 40.0, 50.0, 0.05, 0.1, 1.5e-6, 1.2}),
-    [](const ::testing::TestParamInfo<Case>& p) { return std::string(p.param.motor); });
+// The motors and boards of identification_cases.hpp (rotating_board: a 4096-count encoder).
+INSTANTIATE_TEST_SUITE_P(Motors, InertiaIdentification,
+                         ::testing::Values(test_cases::kSeed000, test_cases::kSeed001,
+                                           test_cases::kSmall, test_cases::kSixPole),
+                         test_cases::case_name);
 
 // A shaft that cannot turn in the test's time (here: a thousand times the inertia) is not an
 // error: the electrical result stands and the mechanics are left to the record.
 TEST(InertiaIdentification, AShaftThatDoesNotTurnSkipsTheStep) {
-  const Case c{"small_4pole_750W", {400.0, 1.9, 50.0, 2}, 540.0, 6.0, 10.0, 0.01, 0.02, 1e-6, 1.0};
+  const Case& c = test_cases::kSmall;
   control::MotorParameters heavy = motor_named(c.motor);
   heavy.J_kgm2 *= 1000.0;
-  const sim::SimBoardConfig b = board_for(c);
+  const sim::SimBoardConfig b = rotating_board(c);
   InertiaPlan ip = plan_inertia_test(c.nameplate, c.i_max_A, c.v_bus_V, b.period_s, b.encoder_cpr);
   ip.max_accelerate_s = 2.0;
   Rig<double> rig(heavy, b, plan_identification(c.nameplate, c.i_max_A, c.v_bus_V, b.period_s), ip);
@@ -156,8 +133,8 @@ TEST(InertiaIdentification, AShaftThatDoesNotTurnSkipsTheStep) {
 // An encoder that counts against the phase sequence: the rotor turns the other way from the
 // torque's; the step stops at once with the reason, the PWM off, nothing adopted.
 TEST(InertiaIdentification, AnEncoderCountingBackwardsIsNamed) {
-  const Case c{"small_4pole_750W", {400.0, 1.9, 50.0, 2}, 540.0, 6.0, 10.0, 0.01, 0.02, 1e-6, 1.0};
-  const sim::SimBoardConfig b = board_for(c);
+  const Case& c = test_cases::kSmall;
+  const sim::SimBoardConfig b = rotating_board(c);
   Rig<float> rig(motor_named(c.motor), b,
                  plan_identification(c.nameplate, c.i_max_A, c.v_bus_V, b.period_s),
                  plan_inertia_test(c.nameplate, c.i_max_A, c.v_bus_V, b.period_s, b.encoder_cpr));
@@ -175,8 +152,8 @@ TEST(InertiaIdentification, AnEncoderCountingBackwardsIsNamed) {
 // the start of the rotating step: the rotor runs away from the test or cannot be braked. The
 // step ends with the PWM off and the reason, never under power for ever, nothing adopted.
 TEST(InertiaIdentification, AShaftDrivenByItsLoadIsLeftWithThePwmOff) {
-  const Case c{"small_4pole_750W", {400.0, 1.9, 50.0, 2}, 540.0, 6.0, 10.0, 0.01, 0.02, 1e-6, 1.0};
-  const sim::SimBoardConfig b = board_for(c);
+  const Case& c = test_cases::kSmall;
+  const sim::SimBoardConfig b = rotating_board(c);
   Rig<float> rig(motor_named(c.motor), b,
                  plan_identification(c.nameplate, c.i_max_A, c.v_bus_V, b.period_s),
                  plan_inertia_test(c.nameplate, c.i_max_A, c.v_bus_V, b.period_s, b.encoder_cpr));
@@ -197,8 +174,9 @@ TEST(InertiaIdentification, AShaftDrivenByItsLoadIsLeftWithThePwmOff) {
 // A nameplate with the wrong pole-pair count (1 for a six-pole motor): the field cannot be
 // oriented, the speed settles far below the test speed. Named, not taken for a locked shaft.
 TEST(InertiaIdentification, AWrongPolePairCountStallsAndIsNamed) {
-  const Case c{"six_pole_7kW", {400.0, 14.0, 50.0, 1}, 540.0, 40.0, 50.0, 0.05, 0.1, 1.5e-6, 1.2};
-  const sim::SimBoardConfig b = board_for(c);
+  Case c = test_cases::kSixPole;
+  c.nameplate.pole_pairs = 1;
+  const sim::SimBoardConfig b = rotating_board(c);
   Rig<float> rig(motor_named(c.motor), b,
                  plan_identification(c.nameplate, c.i_max_A, c.v_bus_V, b.period_s),
                  plan_inertia_test(c.nameplate, c.i_max_A, c.v_bus_V, b.period_s, b.encoder_cpr));

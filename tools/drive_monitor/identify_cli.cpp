@@ -49,17 +49,9 @@ int run_identify(const IdentifyOptions& o) {
   if (!bus) return fail(error);
   const auto node = static_cast<uint8_t>(o.node);
   const StopSignals stop_signals;
-  std::optional<uint8_t> last;
-  receive_until(*bus, o.wait_heartbeat_s, [&](const hal::CanFrame& f) {
-    last = heartbeat_command_counter(f, node);
-    return last.has_value();
-  });
-  if (!last) {
-    return fail("no heartbeat from node " + std::to_string(o.node) + " on " + o.can + " within " +
-                    seconds_text(o.wait_heartbeat_s) + " s",
-                kExitNoAnswer);
-  }
-  ParameterSession session(*bus, node, static_cast<uint8_t>((*last + 1) & 0x0F), o.wait_s);
+  const std::optional<uint8_t> counter = first_counter(*bus, node, o.can, o.wait_heartbeat_s);
+  if (!counter) return kExitNoAnswer;
+  ParameterSession session(*bus, node, *counter, o.wait_s);
   const protocol::Command identify{protocol::CommandKind::identify, o.rotate ? 1.0f : 0.0f};
   const hal::CanFrame frame = session.encode(identify);
   if (!bus->try_send(frame)) return fail("identify: cannot send", kExitNoAnswer);

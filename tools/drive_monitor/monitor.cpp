@@ -188,9 +188,9 @@ std::string csv_header() {
 }
 
 std::string csv_row(const TelemetryRow& row) {
-  const double values[] = {row.speed_rad_s, row.speed_ref_rad_s, row.flux2_Wb2, row.flux2_ref_Wb2,
-                           row.iA_A,       row.iB_A,           row.load_Nm,   row.v_bus_V,
-                           row.u_alpha_V,   row.u_beta_V};
+  const double values[] = {
+      row.speed_rad_s, row.speed_ref_rad_s, row.flux2_Wb2, row.flux2_ref_Wb2, row.iA_A,
+      row.iB_A,        row.load_Nm,         row.v_bus_V,   row.u_alpha_V,     row.u_beta_V};
   static_assert(std::size(values) == std::size(kColumns));
   char time[32];
   std::snprintf(time, sizeof time, "%.6f", row.time_s);

@@ -47,6 +47,11 @@ class ParameterSession {
   double wait_s_;
 };
 
+/// The alive counter a session starts from: one past the last command the drive accepted, as
+/// its heartbeat says. Without a heartbeat within `wait_s`, prints why and returns nullopt.
+std::optional<uint8_t> first_counter(hal::SocketCanBus& bus, uint8_t node, const std::string& can,
+                                     double wait_s);
+
 /// Reads every field of the record and prints it; with `motor_out`, writes the motor as a motor
 /// file named after the node. Returns 0, or an exit code with its message printed.
 int read_record(ParameterSession& session, int node, const std::string& can,

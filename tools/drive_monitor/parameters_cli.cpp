@@ -81,17 +81,9 @@ int run_parameters(const ParametersOptions& o) {
   if (!bus) return fail(error);
   const auto node = static_cast<uint8_t>(o.node);
   const StopSignals stop_signals;
-  std::optional<uint8_t> last;
-  receive_until(*bus, o.wait_heartbeat_s, [&](const hal::CanFrame& f) {
-    last = heartbeat_command_counter(f, node);
-    return last.has_value();
-  });
-  if (!last) {
-    return fail("no heartbeat from node " + std::to_string(o.node) + " on " + o.can + " within " +
-                    seconds_text(o.wait_heartbeat_s) + " s",
-                kExitNoAnswer);
-  }
-  ParameterSession session(*bus, node, static_cast<uint8_t>((*last + 1) & 0x0F), o.wait_s);
+  const std::optional<uint8_t> counter = first_counter(*bus, node, o.can, o.wait_heartbeat_s);
+  if (!counter) return kExitNoAnswer;
+  ParameterSession session(*bus, node, *counter, o.wait_s);
 
   int status = 0;
   // A new motor's inductances may pass through a record without leakage when written one at a
@@ -119,6 +111,22 @@ int run_parameters(const ParametersOptions& o) {
   }
   const int read_status = read_record(session, o.node, o.can, o.motor_out);
   return read_status != 0 ? read_status : status;
+}
+
+std::optional<uint8_t> first_counter(hal::SocketCanBus& bus, uint8_t node, const std::string& can,
+                                     double wait_s) {
+  std::optional<uint8_t> last;
+  receive_until(bus, wait_s, [&](const hal::CanFrame& f) {
+    last = heartbeat_command_counter(f, node);
+    return last.has_value();
+  });
+  if (!last) {
+    fail("no heartbeat from node " + std::to_string(node) + " on " + can + " within " +
+             seconds_text(wait_s) + " s",
+         kExitNoAnswer);
+    return std::nullopt;
+  }
+  return static_cast<uint8_t>((*last + 1) & 0x0F);
 }
 
 int read_record(ParameterSession& session, int node, const std::string& can,
