@@ -41,6 +41,13 @@ InductionMotorPlant::InductionMotorPlant(const control::MotorParameters& motor,
   assert(config.period_s > 0.0 && config.rk4_substeps >= 1);
 }
 
+void InductionMotorPlant::set_resistances(double Rs_Ohm, double Rr_Ohm) noexcept {
+  assert(Rs_Ohm > 0.0 && Rr_Ohm > 0.0);
+  motor_.Rs_Ohm = Rs_Ohm;
+  motor_.Rr_Ohm = Rr_Ohm;
+  k_ = control::derive_voltage_fed(motor_);
+}
+
 void InductionMotorPlant::set_open_phases(unsigned mask) noexcept {
   assert(mask < 8u);
   open_phases_ = mask;

@@ -64,6 +64,9 @@ class InductionMotorPlant {
   const PlantConfig& config() const noexcept { return config_; }
   int pole_pairs() const noexcept { return motor_.pole_pairs; }
   const control::MotorParameters& motor() const noexcept { return motor_; }
+  /// Changes the winding resistances from now on (a stator or rotor heating up); the state
+  /// carries over. Both must be > 0.
+  void set_resistances(double Rs_Ohm, double Rr_Ohm) noexcept;
 
   /// Opens phases from now on. With one phase open and the star point floating, the open
   /// terminal's potential is free, and a change of it moves the phase-to-neutral voltages along

@@ -22,6 +22,8 @@ using detail::Reader;
 
 const std::set<std::string> kMotorKeys = {"Rs_Ohm", "Ls_H",   "Lm_H",       "Rr_Ohm",
                                           "Lr_H",   "J_kgm2", "pole_pairs", "friction_Nms"};
+/// [plant] keys that are not the motor's: its resistances' drift over the run.
+const std::set<std::string> kDriftKeys = {"Rs_scale_end", "Rr_scale_end"};
 
 /// Parses VALUE as a TOML value; a bare word that is not TOML becomes a string.
 toml::table parse_override_value(const std::string& text) {
@@ -149,10 +151,12 @@ control::MotorParameters parse_plant_table(const toml::table& doc, const std::st
   toml::table completed = base ? *base : *doc.get("motor")->as_table();  // checked
   const toml::table changes = plant != nullptr ? *plant->as_table() : toml::table{};
   for (auto&& [key, value] : changes) {
+    if (kDriftKeys.count(std::string(key.str()))) continue;  // not the motor's: the run's
     if (!kMotorKeys.count(std::string(key.str())) && key.str() != "name") {
       throw ConfigError(
           fmt::format("{}: unknown key plant.{} (a motor key: Rs_Ohm, Ls_H, Lm_H, "
-                      "Rr_Ohm, Lr_H, J_kgm2, pole_pairs, friction_Nms)",
+                      "Rr_Ohm, Lr_H, J_kgm2, pole_pairs, friction_Nms; or Rr_scale_end, "
+                      "Rs_scale_end)",
                       source, key.str()));
     }
     completed.insert_or_assign(key, value);
@@ -318,6 +322,14 @@ Scenario load_scenario(const std::filesystem::path& path, const std::vector<std:
   s.duration_s = r.positive("simulation.duration_s", 1.0);
   if (s.duration_s > 3600.0)
     r.fail("simulation.duration_s", fmt::format("= {}: must be <= 3600 s", s.duration_s));
+  // The windings' drift over the run (a rotor heating up): within what a copper or aluminium
+  // winding does between -40 and 200 degC, with room on both sides.
+  s.Rs_scale_end = r.positive("plant.Rs_scale_end", 1.0);
+  s.Rr_scale_end = r.positive("plant.Rr_scale_end", 1.0);
+  for (const char* key : {"plant.Rs_scale_end", "plant.Rr_scale_end"}) {
+    const double scale = r.number(key, 1.0);
+    if (scale < 0.2 || scale > 5.0) r.fail(key, fmt::format("= {}: must be in [0.2, 5]", scale));
+  }
   s.substeps = static_cast<int>(r.integer("simulation.substeps", 10, 1, 10000));
   s.inner_feedback =
       r.choice("simulation.inner_feedback", "digital", {"digital", "ideal_analog"}) == "digital"

@@ -73,6 +73,9 @@ struct Scenario {
   control::MotorParameters motor;  ///< what the controller knows: [motor] or motor_file
   /// The simulated motor: [motor] changed by the keys of [plant] (the same without it).
   control::MotorParameters plant;
+  /// [plant] Rs_scale_end, Rr_scale_end: the plant's resistances drift linearly from their
+  /// value to this multiple of it over the run (sim::ResistanceDrift).
+  double Rs_scale_end = 1.0, Rr_scale_end = 1.0;
 
   // [drive]
   double sample_period_s = 1e-4;

@@ -1,5 +1,6 @@
 #include "hal_sim/sim_board.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include "control/svpwm.hpp"
@@ -29,6 +30,8 @@ class InverterError final : public CurrentDependentVoltage {
 SimBoard::SimBoard(const control::MotorParameters& motor, const SimBoardConfig& config)
     : config_(config),
       plant_(motor, {config.period_s, config.substeps}),
+      Rs0_Ohm_(motor.Rs_Ohm),
+      Rr0_Ohm_(motor.Rr_Ohm),
       adc_model_(config.adc, config.seed),
       pwm_(static_cast<float>(config.period_s)),
       encoder_(config.encoder_cpr),
@@ -53,7 +56,15 @@ void SimBoard::begin_period() {
   latch_sensors();
 }
 
+void SimBoard::drift_resistances() noexcept {
+  const ResistanceDrift& d = config_.drift;
+  const double share = std::min(plant_.time_s() / d.duration_s, 1.0);
+  plant_.set_resistances(Rs0_Ohm_ * (1.0 + (d.Rs_scale_end - 1.0) * share),
+                         Rr0_Ohm_ * (1.0 + (d.Rr_scale_end - 1.0) * share));
+}
+
 void SimBoard::end_period() {
+  if (config_.drift.active()) drift_resistances();
   const double load_now_Nm = load_Nm();
   // What the firmware wrote this tick acts now (no latency) or from the next tick.
   const Vec2 written_analog(analog_.v_A_V(), analog_.v_B_V());

@@ -31,6 +31,17 @@ enum class InnerFeedback {
   ideal_analog,  ///< (2) is evaluated continuously by the analog device (paper's scheme)
 };
 
+/// The windings heating (or cooling) over a run: the plant's resistances go linearly from their
+/// value at t = 0 to `scale_end` times it at `duration_s`, and stay there.
+struct ResistanceDrift {
+  double Rs_scale_end = 1.0;
+  double Rr_scale_end = 1.0;
+  double duration_s = 0.0;  ///< 0: no drift
+  bool active() const noexcept {
+    return duration_s > 0.0 && (Rs_scale_end != 1.0 || Rr_scale_end != 1.0);
+  }
+};
+
 struct SimBoardConfig {
   double period_s = 1e-4;
   int substeps = 10;          ///< RK4 steps per period
@@ -42,6 +53,7 @@ struct SimBoardConfig {
   uint32_t encoder_cpr = 8192;
   AdcModelConfig adc;
   uint64_t seed = 1;
+  ResistanceDrift drift;
 };
 
 class SimBoard {
@@ -100,9 +112,12 @@ class SimBoard {
 
  private:
   void latch_sensors();
+  /// The plant's resistances for the period that starts now (ResistanceDrift).
+  void drift_resistances() noexcept;
 
   SimBoardConfig config_;
   InductionMotorPlant plant_;
+  double Rs0_Ohm_, Rr0_Ohm_;  ///< the plant's resistances at t = 0
   AdcModel adc_model_;
   LoadProfile load_;
   SimPwm pwm_;

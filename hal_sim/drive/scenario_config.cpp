@@ -20,6 +20,7 @@ SimBoardConfig board_config(const Scenario& s) {
   c.encoder_cpr = s.encoder_cpr;
   c.adc = s.adc;
   c.seed = s.seed;
+  c.drift = {s.Rs_scale_end, s.Rr_scale_end, s.duration_s};
   return c;
 }
 
