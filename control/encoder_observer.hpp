@@ -149,6 +149,14 @@ class EncoderObserver {
     correct(theta_measured_rad);
   }
 
+  /// Takes over the state of the object this one replaces (the same motor but for its
+  /// rotor resistance): the tick changes coefficients and keeps state (docs/robustness.md).
+  void continue_from(const EncoderObserver& old) noexcept {
+    theta_ = old.theta_;
+    omega_ = old.omega_;
+    load_ = old.load_;
+  }
+
  private:
   static T wrap_2pi(T angle_rad) noexcept {
     return wrap_pi(angle_rad - T(std::numbers::pi)) + T(std::numbers::pi);

@@ -77,6 +77,12 @@ class FluxFrameCurrentLoop {
     return Vec2<T>(c.x() + d, c.y() + std::clamp(u.y() - c.y(), -q_room, q_room));
   }
 
+  /// Takes over the state of the object this one replaces (the same motor but for its
+  /// rotor resistance): the tick changes coefficients and keeps state (docs/robustness.md).
+  void continue_from(const FluxFrameCurrentLoop& old) noexcept {
+    integral_V_ = old.integral_V_;
+  }
+
  private:
   T kp_, ki_, sigma_, sigma_gamma_, rotor_emf_, Lm_over_Lr_, p_;
   Vec2<T> integral_V_ = Vec2<T>::Zero();

@@ -22,6 +22,12 @@ class FluxObserver {
     flux_ = a11_ * flux_ + a12_ * i_s_AB_A + b1_ * v_AB_V;
   }
 
+  /// Takes over the state of the object this one replaces (the same motor but for its
+  /// rotor resistance): the tick changes coefficients and keeps state (docs/robustness.md).
+  void continue_from(const FluxObserver& old) noexcept {
+    flux_ = old.flux_;
+  }
+
  private:
   T a11_, a12_, b1_;
   Vec2<T> flux_ = Vec2<T>::Zero();

@@ -52,6 +52,12 @@ class FluxOuterLoop {
   }
   void reset() noexcept { integral_ = T(0); }
 
+  /// Takes over the state of the object this one replaces (the same motor but for its
+  /// rotor resistance): the tick changes coefficients and keeps state (docs/robustness.md).
+  void continue_from(const FluxOuterLoop& old) noexcept {
+    integral_ = old.integral_;
+  }
+
  private:
   T e_, kp_, ki_;
   T integral_ = T(0);

@@ -131,6 +131,14 @@ class Ifoc {
   const RotorFluxModel<T>& flux_model() const noexcept { return flux_model_; }
   const SpeedPi<T>& speed_pi() const noexcept { return speed_pi_; }
 
+  /// Takes over the state of the object this one replaces (the same motor but for its
+  /// rotor resistance): the tick changes coefficients and keeps state (docs/robustness.md).
+  void continue_from(const Ifoc& old) noexcept {
+    flux_model_.continue_from(old.flux_model_);
+    speed_pi_.continue_from(old.speed_pi_);
+    current_loop_.continue_from(old.current_loop_);
+  }
+
  private:
   RotorFluxModel<T> flux_model_;
   SpeedPi<T> speed_pi_;

@@ -53,6 +53,14 @@ class RotorFluxModel {
   T slip_rad_s() const noexcept { return slip_rad_s_; }  ///< electrical
   T angle_rad() const noexcept { return angle_rad_; }
 
+  /// Takes over the state of the object this one replaces (the same motor but for its
+  /// rotor resistance): the tick changes coefficients and keeps state (docs/robustness.md).
+  void continue_from(const RotorFluxModel& old) noexcept {
+    flux_Wb_ = old.flux_Wb_;
+    angle_rad_ = old.angle_rad_;
+    slip_rad_s_ = old.slip_rad_s_;
+  }
+
  private:
   T decay_, alpha_Lm_, Lm_, period_s_, min_flux_Wb_;
   T flux_Wb_ = T(0), angle_rad_ = T(0), slip_rad_s_ = T(0);

@@ -38,7 +38,10 @@ struct RotorResistanceMrasConfig {
 template <typename T>
 class RotorResistanceMras {
  public:
-  RotorResistanceMras(const MotorParameters& motor, const RotorResistanceMrasConfig& c) noexcept
+  /// `motor`: the model's motor, whose Rr the estimate starts from; `nominal_Rr_Ohm`: the
+  /// value the bounds min_scale and max_scale refer to (the motor record's).
+  RotorResistanceMras(const MotorParameters& motor, const RotorResistanceMrasConfig& c,
+                      double nominal_Rr_Ohm) noexcept
       : period_s_(T(c.sample_period_s)),
         Lm_H_(T(motor.Lm_H)),
         Lm_over_Lr_(T(motor.Lm_H / motor.Lr_H)),
@@ -49,8 +52,8 @@ class RotorResistanceMras {
         gain_(T(c.sample_period_s / convergence_s(motor, c))),
         min_tangent_(T(c.min_slip_tangent)),
         min_frequency_(T(c.min_frequency_rad_s)),
-        Rr_min_Ohm_(T(c.min_scale * motor.Rr_Ohm)),
-        Rr_max_Ohm_(T(c.max_scale * motor.Rr_Ohm)),
+        Rr_min_Ohm_(T(c.min_scale * nominal_Rr_Ohm)),
+        Rr_max_Ohm_(T(c.max_scale * nominal_Rr_Ohm)),
         Rr_Ohm_(T(motor.Rr_Ohm)) {}
 
   /// The rules' time constants for this motor (for documentation and the service loop).

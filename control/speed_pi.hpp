@@ -53,6 +53,14 @@ class SpeedPi {
   }
   void reset(T integral_Nm = T(0)) noexcept { integral_ = integral_Nm; }
 
+  /// Takes over the state of the object this one replaces (the same motor but for its
+  /// rotor resistance): the tick changes coefficients and keeps state (docs/robustness.md).
+  void continue_from(const SpeedPi& old) noexcept {
+    integral_ = old.integral_;
+    last_increment_ = old.last_increment_;
+    saturated_ = old.saturated_;
+  }
+
  private:
   T kp_, ki_T0_, limit_;
   T integral_ = T(0);

@@ -8,12 +8,16 @@
 
 namespace imd::firmware {
 
+namespace {
+
 template <typename T>
-std::optional<MotorModel<T>> Drive<T>::build(const std::optional<MotorRecord>& record,
-                                             const DriveConfig& config, const BoardScales& board) {
+std::optional<MotorModel<T>> build(const std::optional<MotorRecord>& record,
+                                   const DriveConfig& config, const BoardScales& board) {
   if (!record) return std::nullopt;
   return std::optional<MotorModel<T>>(std::in_place, record->motor, config, board);
 }
+
+}  // namespace
 
 template <typename T>
 Drive<T>::Drive(const std::optional<MotorRecord>& record, const DriveConfig& config,
@@ -27,15 +31,16 @@ Drive<T>::Drive(const std::optional<MotorRecord>& record, const DriveConfig& con
                      {config.adc_calibration_ticks, config.adc_offset_limit_A}),
       sensing_(substitutes.sensing != nullptr ? *substitutes.sensing : board_sensing_),
       bank_(record),
-      model_(build(record, config, board_)),
-      model_ready_(model_.has_value()),
-      attached_(model_ ? &*model_ : nullptr),
+      models_{build<T>(record, config, board_), std::nullopt},
+      model_ready_(models_[0].has_value()),
+      attached_(models_[0] ? &*models_[0] : nullptr),
+      tracking_(config.rotor_resistance_tracking && substitutes.power_stage == nullptr),
       protection_(config),
       telemetry_(config.node_id, peripherals.timer.period_ns(), config.telemetry_rate_Hz,
                  static_cast<float>(1e9 / double(peripherals.timer.execution_clock_Hz()))),
       supervisor_(config, {peripherals.can, peripherals.gpio, telemetry_, &bank_},
-                  substitutes.references, model_ ? &model_->laws : nullptr,
-                  model_ ? &model_->magnetizer : nullptr,
+                  substitutes.references, attached_ ? &attached_->laws : nullptr,
+                  attached_ ? &attached_->magnetizer : nullptr,
                   config.compensate_latency && config.pwm_latency_ticks > 0,
                   config.adc_calibration_ticks <= 0),
       clock_Hz_(peripherals.timer.execution_clock_Hz()),
@@ -77,8 +82,16 @@ void Drive<T>::on_tick() noexcept {
 template <typename T>
 inline MotorModel<T>* Drive<T>::model(uint64_t k) noexcept {
   if (attached_ == nullptr && model_ready_.load(std::memory_order_acquire)) {
-    attached_ = &*model_;
+    attached_ = &*models_[active_];
     supervisor_.attach(&attached_->laws, &attached_->magnetizer, k);
+  } else if (attached_ != nullptr && retune_ready_.load(std::memory_order_acquire)) {
+    // The model on the tracked rotor resistance takes over from this tick, state and all.
+    MotorModel<T>& next = *models_[active_ ^ 1];
+    next.continue_from(*attached_);
+    active_ ^= 1;
+    attached_ = &next;
+    supervisor_.attach(&next.laws, &next.magnetizer, k);
+    retune_ready_.store(false, std::memory_order_release);  // the old one is the service's
   }
   return attached_;
 }
@@ -88,7 +101,7 @@ void Drive<T>::release_model() noexcept {
   attached_ = nullptr;
   supervisor_.attach(nullptr, nullptr, 0);
   model_ready_.store(false, std::memory_order_relaxed);
-  bank_.request_apply();  // release: from here the service loop owns model_
+  bank_.request_apply();  // release: from here the service loop owns the models
 }
 
 template <typename T>
@@ -105,15 +118,51 @@ void Drive<T>::service() noexcept {
       return;
     case ParameterBank::Stage::apply:
       // The tick let go of the model before it asked: it is the service loop's to rebuild.
-      model_.reset();
-      model_.emplace(bank_.staged(), config_, board_);
-      model_ready_.store(true, std::memory_order_release);
+      rebuild(bank_.staged());
       bank_.applied();
       return;
     case ParameterBank::Stage::free:
     case ParameterBank::Stage::answered:
+      retune();
       return;
   }
+}
+
+template <typename T>
+void Drive<T>::rebuild(const control::MotorParameters& motor) noexcept {
+  // The tick has let go of every model (it swaps only while attached).
+  retune_ready_.store(false, std::memory_order_relaxed);
+  models_[active_ ^ 1].reset();
+  models_[active_].reset();
+  models_[active_].emplace(motor, config_, board_);
+  model_ready_.store(true, std::memory_order_release);
+}
+
+template <typename T>
+void Drive<T>::retune() noexcept {
+  if (!tracking_ || !model_ready_.load(std::memory_order_acquire) ||
+      retune_ready_.load(std::memory_order_acquire)) {
+    return;  // not tracking, no model, or the last retune not yet taken
+  }
+  const uint64_t k = hw_.timer.tick_count();
+  if (double(k - last_retune_tick_) * config_.sample_period_s < config_.rr_retune_interval_s) {
+    return;
+  }
+  const MotorModel<T>& now = *models_[active_];
+  const double estimate_Ohm = double(rr_estimate_Ohm_.load(std::memory_order_relaxed));
+  if (!(estimate_Ohm > 0.0) ||
+      std::abs(estimate_Ohm / now.motor.Rr_Ohm - 1.0) < config_.rr_retune_share) {
+    return;
+  }
+  const std::optional<control::MotorParameters> record = bank_.record();
+  if (!record) return;
+  control::MotorParameters motor = now.motor;
+  motor.Rr_Ohm = estimate_Ohm;
+  models_[active_ ^ 1].reset();
+  models_[active_ ^ 1].emplace(motor, config_, board_, record->Rr_Ohm);
+  last_retune_tick_ = k;
+  ++retunes_;
+  retune_ready_.store(true, std::memory_order_release);
 }
 
 template <typename T>
@@ -143,10 +192,11 @@ void Drive<T>::adopt_commissioning() noexcept {
       commissioned_motor(identifier_->electrical(), *bank_.nameplate(), bank_.record(),
                          identifier_->mechanics());
   const ParameterStatus status = bank_.adopt(motor, hw_.store);
-  model_.reset();
   if (const auto record = bank_.record()) {  // the new motor, or the old one if refused
-    model_.emplace(*record, config_, board_);
-    model_ready_.store(true, std::memory_order_release);
+    rebuild(*record);
+  } else {
+    models_[0].reset();
+    models_[1].reset();
   }
   bank_.answer(status);
 }
@@ -199,6 +249,10 @@ inline Estimate<T> Drive<T>::estimate(const Measurement<T>& m, MotorModel<T>* mo
       substitutes_.estimator != nullptr ? *substitutes_.estimator : model->observers;
   Estimate<T> e = estimator.estimate(m);
   model->predictor.set_input_state(e);
+  // The rotor resistance moves only while a law runs on a magnetized motor.
+  const bool adapt = tracking_ && supervisor_.state() == DriveState::running;
+  model->rotor_resistance.step(m.i_alphabeta_A, e.x.i_s_AB_A, e.x.omega_mech_rad_s,
+                               u_last_period_V_, adapt);
   return e;
 }
 
@@ -233,6 +287,7 @@ template <typename T>
 inline void Drive<T>::actuate(uint64_t k, const Estimate<T>& e, const Modulation<T>& out,
                               const Trip& trip, MotorModel<T>* model) noexcept {
   v_applied_V_ = Vec2::Zero();
+  Vec2 u_applied_V = Vec2::Zero();
   if (trip.any()) {
     supervisor_.latch(trip, k);
     pwm_off();
@@ -247,16 +302,20 @@ inline void Drive<T>::actuate(uint64_t k, const Estimate<T>& e, const Modulation
     stage.write(out);
     u_written_V_ = out.u_alphabeta_V;
     v_applied_V_ = out.v_acting_AB_V;
+    u_applied_V = out.u_acting_alphabeta_V;
   } else {
     if (hw_.pwm.enabled()) pwm_off();
     u_written_V_ = Vec2::Zero();
   }
-  if (!hw_.pwm.enabled()) v_applied_V_ = Vec2::Zero();
+  if (!hw_.pwm.enabled()) v_applied_V_ = u_applied_V = Vec2::Zero();
   // The observers advance over [k, k+1] with the input acting on it.
   if (e.valid && model != nullptr) {
     StateEstimator<T>& estimator =
         substitutes_.estimator != nullptr ? *substitutes_.estimator : model->observers;
     estimator.advance(model->predictor.written(v_applied_V_));
+    u_last_period_V_ = model->predictor.written_stator(u_applied_V);
+  } else {
+    u_last_period_V_ = Vec2::Zero();
   }
 }
 
@@ -291,6 +350,9 @@ inline void Drive<T>::publish(uint64_t k, const Measurement<T>& m, const Estimat
     r.controlled_flux2_Wb2 = model->magnetizer.flux2_Wb2(e.x, flux);
     r.load_est_Nm = e.load_Nm;
     r.i_s_est_AB_A = e.x.i_s_AB_A;
+    r.rr_est_Ohm = model->rotor_resistance.Rr_Ohm();
+    r.rr_adapting = model->rotor_resistance.adapting();
+    rr_estimate_Ohm_.store(static_cast<float>(r.rr_est_Ohm), std::memory_order_relaxed);
     r.v_AB_V = v_applied_V_;
     r.omega_ref_rad_s = plan.next.omega_mech_rad_s;
     r.flux2_ref_Wb2 = plan.next.flux2_Wb2;

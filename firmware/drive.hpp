@@ -98,6 +98,8 @@ class Drive final : public hal::TickHandler {
   uint32_t execution_clock_Hz() const noexcept { return clock_Hz_; }
   /// The motor record the drive runs on, if it has a complete one (not for tick context).
   std::optional<control::MotorParameters> motor() const noexcept;
+  /// How often the service loop rebuilt the model on a tracked rotor resistance.
+  uint32_t retunes() const noexcept { return retunes_; }
   const ParameterBank& parameters() const noexcept { return bank_; }
 
  private:
@@ -109,6 +111,10 @@ class Drive final : public hal::TickHandler {
   [[gnu::always_inline]] MotorModel<T>* model(uint64_t k) noexcept;
   /// A parameter write asked for a new model: the tick lets go of the old one.
   void release_model() noexcept;
+  /// Service loop: the model rebuilt on the tracked rotor resistance, when it moved enough.
+  void retune() noexcept;
+  /// Service loop: a new record replaces the model (and any retuned one in waiting).
+  void rebuild(const control::MotorParameters& motor) noexcept;
   [[gnu::always_inline]] Estimate<T> estimate(const Measurement<T>& m,
                                               MotorModel<T>* model) noexcept;
   [[gnu::always_inline]] LawOutput<T> law(const TickPlan<T>& plan, const Estimate<T>& e,
@@ -132,8 +138,6 @@ class Drive final : public hal::TickHandler {
   [[gnu::always_inline]] void publish(uint64_t k, const Measurement<T>& m, const Estimate<T>& e,
                                       const TickPlan<T>& plan, const LawOutput<T>& u,
                                       const Modulation<T>& out, MotorModel<T>* model) noexcept;
-  static std::optional<MotorModel<T>> build(const std::optional<MotorRecord>& record,
-                                            const DriveConfig& config, const BoardScales& board);
   void pwm_off() noexcept;
   /// Drives one of the board's output lines (nothing when the line is not wired).
   void write_line(int line, bool level) noexcept;
@@ -145,10 +149,18 @@ class Drive final : public hal::TickHandler {
   BoardSensing<T> board_sensing_;
   Sensing<T>& sensing_;
   ParameterBank bank_;
-  /// Built outside the tick (construction, service); the tick uses it through attached_.
-  std::optional<MotorModel<T>> model_;
-  std::atomic<bool> model_ready_;  ///< model_ is whole: set by service, cleared by the tick
+  /// Built outside the tick (construction, service); the tick uses models_[active_] through
+  /// attached_. The other slot takes a model on a tracked rotor resistance, which the tick
+  /// swaps in (retune_ready_) and which then takes over the state.
+  std::optional<MotorModel<T>> models_[2];
+  uint8_t active_ = 0;  ///< changed by the tick only on a swap, before it clears retune_ready_
+  std::atomic<bool> model_ready_;  ///< the active model is whole: set by service, cleared by tick
+  std::atomic<bool> retune_ready_{false};  ///< the other slot is whole: set by service
   MotorModel<T>* attached_;        ///< tick side: the model in use, null while none
+  std::atomic<float> rr_estimate_Ohm_{0.0f};  ///< the tick's latest estimate, for the service
+  uint64_t last_retune_tick_ = 0;
+  uint32_t retunes_ = 0;
+  bool tracking_;  ///< the tracker may move Rr (config, and a power stage that knows its voltage)
   /// Planned by the service loop on an identify command, then run by the tick.
   std::optional<Commissioning<T>> identifier_;
   bool adopt_pending_ = false;  ///< its result still waits for the bank (tick side)
@@ -160,6 +172,7 @@ class Drive final : public hal::TickHandler {
   float ns_per_count_;               ///< execution-clock counts to ns
   Vec2 u_written_V_ = Vec2::Zero();  ///< stator voltage applied over the last period
   Vec2 v_applied_V_ = Vec2::Zero();  ///< rotor-frame input written this tick (zero if off)
+  Vec2 u_last_period_V_ = Vec2::Zero();  ///< stator voltage that acted over [k-1, k]
   bool fault_line_level_ = false;
   int ticks_since_timed_ = 0;  ///< for the stage timing of one tick in N
   TickRecord<T> record_;

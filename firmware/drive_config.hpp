@@ -72,6 +72,13 @@ struct DriveConfig {
   double load_estimator_pole = 0.99;  ///< double pole of the error matrix (13)
   double min_flux2_Wb2 = 1e-3;        ///< below it B_k counts as singular
 
+  // Rotor-resistance tracking (docs/robustness.md): a reactive-power MRAS estimates Rr while
+  // a law runs, and the model is rebuilt on the estimate outside the tick.
+  bool rotor_resistance_tracking = true;
+  double rr_convergence_time_constant_s = 0.0;  ///< at slip tangent 1; 0: 4 tau_r
+  double rr_retune_share = 0.005;   ///< rebuild once the estimate is this far from the model
+  double rr_retune_interval_s = 0.05;  ///< and no more often than this
+
   ProtectionConfig protection;
   /// The tick's stages are timed on one tick in this many (1: every tick); the whole tick is
   /// timed on every tick for its budget.

@@ -306,6 +306,13 @@ Scenario load_scenario(const std::filesystem::path& path, const std::vector<std:
            fmt::format("= {}: must be below 0.1 * inverter.v_bus_V", s.inverter.device_drop_V));
   }
   s.dead_time_compensation = r.boolean("drive.dead_time_compensation", true);
+  s.rotor_resistance_tracking = r.boolean("drive.rotor_resistance_tracking", true);
+  s.rr_convergence_time_constant_s = r.number("drive.rr_convergence_time_constant_s", 0.0);
+  if (s.rr_convergence_time_constant_s < 0.0 || s.rr_convergence_time_constant_s > 100.0) {
+    r.fail("drive.rr_convergence_time_constant_s",
+           fmt::format("= {}: must be in [0, 100] s (0: the rule)",
+                       s.rr_convergence_time_constant_s));
+  }
 
   s.section_iv = r.boolean("observers.section_iv", false);
   if (s.section_iv && !s.ideal_sensors) {

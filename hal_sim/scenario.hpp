@@ -88,6 +88,10 @@ struct Scenario {
   bool compensate_latency = true;    ///< predict over the PWM latency
   double speed_reaching_pole = 0.0;  ///< 0: the paper's deadbeat law
   double flux_reaching_pole = 0.0;
+  /// Track the rotor resistance online (docs/robustness.md); the adaptation's time constant
+  /// at slip tangent 1 (0: four rotor time constants).
+  bool rotor_resistance_tracking = true;
+  double rr_convergence_time_constant_s = 0.0;
 
   // [reference.speed], [reference.flux]
   SpeedProfile speed;

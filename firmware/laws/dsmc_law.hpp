@@ -18,6 +18,9 @@ class DsmcLaw final : public ControlLaw<T> {
               control::DsmcConfig{c.config.min_flux2_Wb2, c.config.speed_reaching_pole,
                                   c.config.flux_reaching_pole}) {}
 
+  /// The law keeps no state from tick to tick: nothing to take over from the one it replaces.
+  void continue_from(const DsmcLaw& old) noexcept { (void)old; }
+
   ControlledFlux controlled_flux() const noexcept override { return ControlledFlux::rotor; }
   bool follows_speed() const noexcept override { return true; }
 

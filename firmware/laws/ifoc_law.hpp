@@ -71,6 +71,12 @@ class IfocLaw final : public ControlLaw<T> {
     return result;
   }
 
+  /// Takes over the state of the object this one replaces (the same motor but for its
+  /// rotor resistance): the tick changes coefficients and keeps state (docs/robustness.md).
+  void continue_from(const IfocLaw& old) noexcept {
+    ifoc_.continue_from(old.ifoc_);
+  }
+
  private:
   control::Ifoc<T> ifoc_;
   InnerFeedback<T> feedback_;

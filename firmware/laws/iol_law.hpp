@@ -52,6 +52,12 @@ class IolLaw final : public ControlLaw<T> {
     return out;
   }
 
+  /// Takes over the state of the object this one replaces (the same motor but for its
+  /// rotor resistance): the tick changes coefficients and keeps state (docs/robustness.md).
+  void continue_from(const IolLaw& old) noexcept {
+    stage_.continue_from(old.stage_);
+  }
+
  private:
   IolStage<T> stage_;
   control::DeadbeatCurrent<T> current_loop_;

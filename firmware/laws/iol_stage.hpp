@@ -101,6 +101,17 @@ class IolStage {
     return r;
   }
 
+  /// Takes over the state of the object this one replaces (the same motor but for its
+  /// rotor resistance): the tick changes coefficients and keeps state (docs/robustness.md).
+  void continue_from(const IolStage& old) noexcept {
+    flux_loop_.continue_from(old.flux_loop_);
+    speed_pi_.continue_from(old.speed_pi_);
+    i_held_ = old.i_held_;
+    i_next_ = old.i_next_;
+    flux_s_before_ = old.flux_s_before_;
+    ticks_ = old.ticks_;
+  }
+
  private:
   control::CurrentFedCoefficients coefficients_;
   control::Iol<T> law_;

@@ -51,6 +51,12 @@ class LawRegistry {
   LawRegistry(const LawRegistry&) = delete;
   LawRegistry& operator=(const LawRegistry&) = delete;
 
+  /// Every law takes over the state of its counterpart in `old` (the same motor but for its
+  /// rotor resistance). Tick context.
+  void continue_from(const LawRegistry& old) noexcept {
+    std::apply([&](auto&... law) { std::apply([&](const auto&... was) { (law.continue_from(was), ...); }, old.laws_); }, laws_);
+  }
+
   ControlLaw<T>& law(ControllerKind kind) noexcept { return *table_[static_cast<int>(kind)]; }
   const ControlLaw<T>& law(ControllerKind kind) const noexcept {
     return *table_[static_cast<int>(kind)];

@@ -44,6 +44,16 @@ class AdcStuckCheck {
     return false;
   }
 
+  /// Takes over the state of the object this one replaces (the same motor but for its
+  /// rotor resistance): the tick changes coefficients and keeps state (docs/robustness.md).
+  void continue_from(const AdcStuckCheck& old) noexcept {
+    same_ticks_ = old.same_ticks_;
+    started_ = old.started_;
+    last_codes_ = old.last_codes_;
+    u_first_V_ = old.u_first_V_;
+    departure_sum_V_ = old.departure_sum_V_;
+  }
+
  private:
   int stuck_ticks_;
   T A_per_V_, evidence_needed_A_;

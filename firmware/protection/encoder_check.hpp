@@ -93,6 +93,15 @@ class EncoderCheck {
     return missing_rad_ + speed_error_T_ * n + load_error_T2_per_2J_ * n * n;
   }
 
+  /// Takes over the state of the object this one replaces (the same motor but for its
+  /// rotor resistance): the tick changes coefficients and keeps state (docs/robustness.md).
+  void continue_from(const EncoderCheck& old) noexcept {
+    silent_ticks_ = old.silent_ticks_;
+    omega_rad_s_ = old.omega_rad_s_;
+    load_Nm_ = old.load_Nm_;
+    travel_rad_ = old.travel_rad_;
+  }
+
  private:
   T period_s_, per_J_, friction_, missing_rad_, speed_error_T_, load_error_T2_per_2J_;
   uint32_t window_ticks_;

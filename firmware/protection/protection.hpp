@@ -52,6 +52,11 @@ struct MotorChecks {
     encoder.reset();
     adc_stuck.reset();
   }
+  /// Takes over the checks' state from the model this one replaces (firmware/motor_model.hpp).
+  void continue_from(const MotorChecks& old) noexcept {
+    encoder.continue_from(old.encoder);
+    adc_stuck.continue_from(old.adc_stuck);
+  }
 
   T pole_pairs, torque_per_AWb;
   EncoderCheck<T> encoder;

@@ -67,6 +67,14 @@ class ObserverEstimator final : public StateEstimator<T> {
     flux_.update(i_s_AB_A_, v_acting_AB_V);
   }
 
+  /// Takes over the state of the object this one replaces (the same motor but for its
+  /// rotor resistance): the tick changes coefficients and keeps state (docs/robustness.md).
+  void continue_from(const ObserverEstimator& old) noexcept {
+    flux_.continue_from(old.flux_);
+    encoder_.continue_from(old.encoder_);
+    i_s_AB_A_ = old.i_s_AB_A_;
+  }
+
  private:
   control::FluxObserver<T> flux_;
   control::EncoderObserver<T> encoder_;

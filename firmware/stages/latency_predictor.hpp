@@ -33,13 +33,31 @@ class LatencyPredictor {
     v_in_flight_V_ = v_V;
     return acting;
   }
+  /// The same for the stator voltage (stationary frame) this tick wrote: returns the one that
+  /// acts over [k, k+1].
+  control::Vec2<T> written_stator(const control::Vec2<T>& u_V) noexcept {
+    const control::Vec2<T> acting = latency_ ? u_in_flight_V_ : u_V;
+    u_in_flight_V_ = u_V;
+    return acting;
+  }
   /// The tick's voltage will never act (an overrun turned the PWM off after it was written).
-  void cancel_in_flight() noexcept { v_in_flight_V_ = control::Vec2<T>::Zero(); }
+  void cancel_in_flight() noexcept {
+    v_in_flight_V_ = control::Vec2<T>::Zero();
+    u_in_flight_V_ = control::Vec2<T>::Zero();
+  }
+
+  /// Takes over the state of the object this one replaces (the same motor but for its
+  /// rotor resistance): the tick changes coefficients and keeps state (docs/robustness.md).
+  void continue_from(const LatencyPredictor& old) noexcept {
+    v_in_flight_V_ = old.v_in_flight_V_;
+    u_in_flight_V_ = old.u_in_flight_V_;
+  }
 
  private:
   control::VoltageFedModel<T> model_;
   bool latency_, predict_;
   control::Vec2<T> v_in_flight_V_ = control::Vec2<T>::Zero();  ///< written last tick
+  control::Vec2<T> u_in_flight_V_ = control::Vec2<T>::Zero();  ///< its stator voltage
 };
 
 }  // namespace imd::firmware

@@ -18,6 +18,9 @@ struct Modulation {
   /// observers and the prediction.
   control::Vec2<T> v_acting_AB_V = control::Vec2<T>::Zero();
   control::Vec2<T> u_alphabeta_V = control::Vec2<T>::Zero();  ///< stator voltage command
+  /// The stator voltage that will act (the command after the voltage limit); zero from a
+  /// power stage that does not know it (an ideal current source).
+  control::Vec2<T> u_acting_alphabeta_V = control::Vec2<T>::Zero();
   hal::PhaseDuties duty{0.5f, 0.5f, 0.5f};
   bool clipped = false;  ///< the request exceeded the linear range and was scaled down
   bool finite = true;    ///< false: a NaN or Inf on the way to the power stage

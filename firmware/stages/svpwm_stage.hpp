@@ -32,12 +32,12 @@ class SvpwmStage final : public PowerStage<T> {
     m.u_alphabeta_V = rotation.apply(compensation + law.v_AB_V);
     const control::SvpwmResult<T> pwm = control::svpwm(m.u_alphabeta_V, v_bus_V);
     m.clipped = pwm.clipped;
+    m.u_acting_alphabeta_V = m.u_alphabeta_V;
     if (pwm.clipped) {
       const T limit = control::svpwm_linear_limit_V(v_bus_V);
       const T magnitude = m.u_alphabeta_V.norm();
-      m.v_acting_AB_V =
-          rotation.apply_inverse(m.u_alphabeta_V * (magnitude > limit ? limit / magnitude : T(1))) -
-          compensation;
+      m.u_acting_alphabeta_V *= magnitude > limit ? limit / magnitude : T(1);
+      m.v_acting_AB_V = rotation.apply_inverse(m.u_acting_alphabeta_V) - compensation;
     }
     m.finite = finite(m.u_alphabeta_V) && finite(m.v_acting_AB_V);
     m.duty = {float(pwm.duty[0]), float(pwm.duty[1]), float(pwm.duty[2])};

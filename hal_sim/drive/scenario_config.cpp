@@ -48,6 +48,8 @@ firmware::DriveConfig drive_config(const Scenario& s) {
   c.voltage_limited = s.limit_voltage;
   c.dead_time_s = s.inverter.dead_time_s;  // the board programs it: the firmware knows it
   c.compensate_dead_time = s.dead_time_compensation;
+  c.rotor_resistance_tracking = s.rotor_resistance_tracking;
+  c.rr_convergence_time_constant_s = s.rr_convergence_time_constant_s;
   c.max_accel_rad_s2 = s.max_accel_rad_s2;
   c.speed_reaching_pole = s.speed_reaching_pole;
   c.flux_reaching_pole = s.flux_reaching_pole;

@@ -142,6 +142,10 @@ Summary run(const Scenario& s, const RunCallbacks& callbacks) {
   summary.i_hold_rms_err_A = observer.i_hold_rms_err_A();
   summary.torque_rms_err_Nm = observer.torque_rms_err_Nm();
   summary.running_from_s = observer.running_from_s();
+  summary.rr_estimate_final_Ohm = observer.rr_estimate_final_Ohm();
+  summary.plant_Rr_final_Ohm = observer.plant_Rr_final_Ohm();
+  summary.rr_rel_err_max = observer.rr_rel_err_max();
+  summary.rr_retunes = drive.retunes();
   const double ns_per_count = 1e9 / double(drive.execution_clock_Hz());
   for (int i = 0; i < firmware::kStageCount; ++i) {
     summary.stage_ns_mean[i] = stages.ticks

@@ -42,6 +42,10 @@ struct Summary {
   /// Each stage's mean execution time (firmware::kStageNames order), over the timed ticks.
   double stage_ns_mean[firmware::kStageCount] = {};
   double running_from_s = -1.0;  ///< first time the drive was running (-1: never)
+  /// The rotor resistance the drive ended with, the plant's then, the largest relative error
+  /// after settle_s (NaN: none), and how often the model was rebuilt on the estimate.
+  double rr_estimate_final_Ohm = 0.0, plant_Rr_final_Ohm = 0.0, rr_rel_err_max = 0.0;
+  uint32_t rr_retunes = 0;
   std::vector<FaultEvent> faults;
   /// A commissioning scenario's report (the run ends with the commissioning).
   std::optional<CommissioningReport> commissioning;

@@ -38,6 +38,8 @@ struct SimRow {
   double iA_est_A = 0.0, iB_est_A = 0.0;  ///< estimated stator current, rotor frame
   double v_bus_meas_V = 0.0;
   double u_alpha_cmd_V = 0.0, u_beta_cmd_V = 0.0;  ///< stator voltage command
+  double rr_est_Ohm = 0.0;    ///< the drive's rotor resistance (tracked, or its model's)
+  double Rr_plant_Ohm = 0.0;  ///< the plant's over the period
   bool iol_boundary = false;
   int state = 0;
   bool saturated = false;
@@ -90,6 +92,11 @@ class TickObserver {
   double torque_rms_err_Nm() const noexcept { return rms(torque_sq_, torque_count_); }
   double i_hold_rms_err_A() const noexcept { return rms(hold_sq_, hold_count_); }
   double running_from_s() const noexcept { return running_from_s_; }  ///< -1: never
+  /// The drive's rotor resistance at the last tick with an estimate, the plant's then, and the
+  /// largest |estimate/plant - 1| after settle_s (NaN: no estimate).
+  double rr_estimate_final_Ohm() const noexcept { return rr_final_Ohm_; }
+  double plant_Rr_final_Ohm() const noexcept { return plant_Rr_final_Ohm_; }
+  double rr_rel_err_max() const noexcept { return rr_rel_err_max_; }
 
  private:
   static double rms(double sum_sq, uint64_t n) noexcept {
@@ -102,6 +109,8 @@ class TickObserver {
   RunMetrics metrics_;
   SimRow row_;
   double running_from_s_ = -1.0;
+  double rr_final_Ohm_ = std::nan(""), plant_Rr_final_Ohm_ = std::nan("");
+  double rr_rel_err_max_ = std::nan("");
   double torque_sq_ = 0, hold_sq_ = 0;
   uint64_t torque_count_ = 0, hold_count_ = 0;
   Vec2 boundary_flux_s_ = Vec2::Zero();       ///< true stator flux (rotor frame), last boundary
@@ -153,6 +162,16 @@ const SimRow& TickObserver<T>::observe(double t_s, const PlantState& truth, doub
   row.v_bus_meas_V = rec.v_bus_V;
   row.u_alpha_cmd_V = rec.u_alphabeta_V.x();
   row.u_beta_cmd_V = rec.u_alphabeta_V.y();
+  row.rr_est_Ohm = rec.rr_est_Ohm;
+  row.Rr_plant_Ohm = board.plant().motor().Rr_Ohm;
+  if (rec.rr_est_Ohm > T(0)) {
+    rr_final_Ohm_ = row.rr_est_Ohm;
+    plant_Rr_final_Ohm_ = row.Rr_plant_Ohm;
+    if (t_s > run_.settle_s) {
+      const double err = std::abs(row.rr_est_Ohm / row.Rr_plant_Ohm - 1.0);
+      rr_rel_err_max_ = std::isnan(rr_rel_err_max_) ? err : std::max(rr_rel_err_max_, err);
+    }
+  }
   row.saturated = rec.law.speed_saturated || rec.law.flux_saturated || rec.law.voltage_limited ||
                   rec.voltage_clipped;
 

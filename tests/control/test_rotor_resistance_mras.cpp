@@ -46,7 +46,7 @@ Outcome run_motor(const test::TestMotor& tm, double tangent, double scale, doubl
   model.Rr_Ohm = scale * m.Rr_Ohm;
   RotorResistanceMrasConfig config;
   config.sample_period_s = T;
-  RotorResistanceMras<double> mras(model, config);
+  RotorResistanceMras<double> mras(model, config, m.Rr_Ohm);
   V2 u_last = V2::Zero();
   int adapting = 0;
   const int ticks = static_cast<int>(duration_s / T);
@@ -114,8 +114,8 @@ TEST(RotorResistanceMras, FloatFollowsDouble) {
   RotorResistanceMrasConfig config;
   MotorParameters model = m;
   model.Rr_Ohm = 1.5 * m.Rr_Ohm;
-  RotorResistanceMras<float> single(model, config);
-  RotorResistanceMras<double> twice(model, config);
+  RotorResistanceMras<float> single(model, config, m.Rr_Ohm);
+  RotorResistanceMras<double> twice(model, config, m.Rr_Ohm);
   // A synthetic steady state in the rotor frame: current and flux turning at the slip.
   const double i_d = tm.flux_Wb / m.Lm_H, omega = 100.0, slip = m.Rr_Ohm / m.Lr_H;
   for (int k = 0; k < 20000; ++k) {

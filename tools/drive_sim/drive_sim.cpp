@@ -90,6 +90,8 @@ const Column kColumns[] = {
     IMD_COLUMN(v_bus_meas_V),
     IMD_COLUMN(u_alpha_cmd_V),
     IMD_COLUMN(u_beta_cmd_V),
+    IMD_COLUMN(rr_est_Ohm),
+    IMD_COLUMN(Rr_plant_Ohm),
 };
 #undef IMD_COLUMN
 
@@ -125,6 +127,11 @@ void commissioning_json(const imd::sim::CommissioningReport& c, nlohmann::ordere
   out["identified"] = identified;
 }
 
+/// A number, or null when it is not defined (NaN).
+nlohmann::ordered_json json_number(double value) {
+  return std::isfinite(value) ? nlohmann::ordered_json(value) : nlohmann::ordered_json(nullptr);
+}
+
 nlohmann::ordered_json summary_json(const imd::sim::Scenario& s, const imd::sim::Summary& r) {
   nlohmann::ordered_json faults = nlohmann::ordered_json::array();
   auto time = [](double t_s) {  // NaN: it did not happen
@@ -157,6 +164,11 @@ nlohmann::ordered_json summary_json(const imd::sim::Scenario& s, const imd::sim:
       {"torque_rms_err_Nm", r.torque_rms_err_Nm},
       {"i_hold_rms_err_A", r.i_hold_rms_err_A},
       {"i_peak_A", r.i_peak_A},
+      {"rotor_resistance_tracking", s.rotor_resistance_tracking},
+      {"rr_estimate_final_Ohm", json_number(r.rr_estimate_final_Ohm)},
+      {"plant_Rr_final_Ohm", json_number(r.plant_Rr_final_Ohm)},
+      {"rr_rel_err_max", json_number(r.rr_rel_err_max)},
+      {"rr_retunes", r.rr_retunes},
       {"i_peak_total_A", r.i_peak_total_A},
       {"i_max_A", std::isfinite(s.i_max_A) ? nlohmann::ordered_json(s.i_max_A)
                                            : nlohmann::ordered_json(nullptr)},

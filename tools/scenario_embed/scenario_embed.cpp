@@ -25,8 +25,8 @@ using imd::firmware::ControllerKind;
 using imd::firmware::DriveConfig;
 
 // A new field must be written here too: these sizes fail the build until it is.
-static_assert(sizeof(DriveConfig) == 408, "DriveConfig changed: write its new fields below");
-static_assert(sizeof(imd::sim::SimBoardConfig) == 128, "SimBoardConfig changed: write it below");
+static_assert(sizeof(DriveConfig) == 440, "DriveConfig changed: write its new fields below");
+static_assert(sizeof(imd::sim::SimBoardConfig) == 152, "SimBoardConfig changed: write it below");
 static_assert(sizeof(imd::control::MotorParameters) == 64, "MotorParameters changed");
 
 class Writer {
@@ -114,6 +114,9 @@ void write_board(Writer& w, const imd::sim::SimBoardConfig& b) {
   w.number("board.adc.bus_full_scale_V", b.adc.bus_full_scale_V);
   w.number("board.adc.bus_noise_V", b.adc.bus_noise_V);
   w.line("board.seed", fmt::format("{}u", b.seed));
+  w.number("board.drift.Rs_scale_end", b.drift.Rs_scale_end);
+  w.number("board.drift.Rr_scale_end", b.drift.Rr_scale_end);
+  w.number("board.drift.duration_s", b.drift.duration_s);
 }
 
 void write_drive(Writer& w, const DriveConfig& c) {
@@ -136,6 +139,10 @@ void write_drive(Writer& w, const DriveConfig& c) {
   w.number("drive.max_accel_rad_s2", c.max_accel_rad_s2);
   w.number("drive.speed_reaching_pole", c.speed_reaching_pole);
   w.number("drive.flux_reaching_pole", c.flux_reaching_pole);
+  w.boolean("drive.rotor_resistance_tracking", c.rotor_resistance_tracking);
+  w.number("drive.rr_convergence_time_constant_s", c.rr_convergence_time_constant_s);
+  w.number("drive.rr_retune_share", c.rr_retune_share);
+  w.number("drive.rr_retune_interval_s", c.rr_retune_interval_s);
   w.boolean("drive.voltage_limited", c.voltage_limited);
   w.number("drive.modulation_margin", c.modulation_margin);
   w.number("drive.i_max_A", c.i_max_A);
