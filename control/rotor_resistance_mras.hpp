@@ -54,6 +54,7 @@ class RotorResistanceMras {
         min_frequency_(T(c.min_frequency_rad_s)),
         Rr_min_Ohm_(T(c.min_scale * nominal_Rr_Ohm)),
         Rr_max_Ohm_(T(c.max_scale * nominal_Rr_Ohm)),
+        inv_nominal_(T(1.0 / nominal_Rr_Ohm)),
         Rr_Ohm_(T(motor.Rr_Ohm)) {}
 
   /// The rules' time constants for this motor (for documentation and the service loop).
@@ -67,6 +68,8 @@ class RotorResistanceMras {
   }
 
   T Rr_Ohm() const noexcept { return Rr_Ohm_; }
+  /// The estimate over the nominal rotor resistance.
+  T scale() const noexcept { return Rr_Ohm_ * inv_nominal_; }
   /// Whether the last step adapted (excited and allowed).
   bool adapting() const noexcept { return adapting_; }
   /// The slip tangent x of the filtered model, and the filtered powers (for telemetry/tests).
@@ -131,7 +134,7 @@ class RotorResistanceMras {
   }
 
   T period_s_, Lm_H_, Lm_over_Lr_, inv_Lr_, sigma_over_T_, p_, filter_, gain_;
-  T min_tangent_, min_frequency_, Rr_min_Ohm_, Rr_max_Ohm_;
+  T min_tangent_, min_frequency_, Rr_min_Ohm_, Rr_max_Ohm_, inv_nominal_;
   T Rr_Ohm_;
   Vec2<T> flux_AB_Wb_ = Vec2<T>::Zero();
   Vec2<T> i_AB_last_A_ = Vec2<T>::Zero(), i_alphabeta_last_A_ = Vec2<T>::Zero();

@@ -352,6 +352,7 @@ inline void Drive<T>::publish(uint64_t k, const Measurement<T>& m, const Estimat
     r.i_s_est_AB_A = e.x.i_s_AB_A;
     r.rr_est_Ohm = model->rotor_resistance.Rr_Ohm();
     r.rr_adapting = model->rotor_resistance.adapting();
+    r.rr_scale = model->rotor_resistance.scale();
     rr_estimate_Ohm_.store(static_cast<float>(r.rr_est_Ohm), std::memory_order_relaxed);
     r.v_AB_V = v_applied_V_;
     r.omega_ref_rad_s = plan.next.omega_mech_rad_s;

@@ -87,7 +87,7 @@ void Telemetry::publish(uint64_t k, hal::CanBus& can, const TickRecord<T>& r,
                        float(r.v_bus_V)}));
     send(can, encode_frame(node_id_, MessageId::telemetry_voltage,
                            {float(r.u_alphabeta_V.x()), float(r.u_alphabeta_V.y()),
-                            float(sample_count_++)}));
+                            float(sample_count_++), float(r.rr_scale)}));
   }
 }
 

@@ -27,6 +27,7 @@ struct TickRecord {
   Vec2 flux_est_AB_Wb = Vec2::Zero();
   Vec2 i_s_est_AB_A = Vec2::Zero();  ///< stator current
   T rr_est_Ohm = T(0);     ///< the tracked rotor resistance (the model's when not tracking)
+  T rr_scale = T(0);       ///< rr_est_Ohm over the motor record's
   bool rr_adapting = false;  ///< the tracker moved the estimate this tick (excited)
   // References the law aimed at (for the step the input acts on).
   T omega_ref_rad_s = T(0), flux2_ref_Wb2 = T(0);

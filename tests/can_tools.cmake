@@ -36,7 +36,7 @@ if(TARGET drive_monitor)
                    "last ack +set_speed counter 3: accepted, rejected_total 1"
                    watch --log ${CAN_DATA}/monitor_sample.log)
   imd_monitor_test(drive_monitor_log_csv 0
-                   "^0\\.130300,37\\.02,100\\.00,0\\.8099,0\\.8100,4\\.50,-2\\.25,0\\.50,301\\.7,30\\.3,-20\\.2,3,running,none$"
+                   "^0\\.130300,37\\.02,100\\.00,0\\.8099,0\\.8100,4\\.50,-2\\.25,0\\.50,301\\.7,30\\.3,-20\\.2,1\\.0000,3,running,none$"
                    watch --log ${CAN_DATA}/monitor_sample.log --csv - --no-table)
   imd_monitor_test(drive_monitor_log_duration 0 "samples +1 rows"
                    watch --log ${CAN_DATA}/monitor_sample.log --duration-s 0.12)

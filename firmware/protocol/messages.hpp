@@ -244,6 +244,8 @@ inline constexpr Signal kVoltageSignals[] = {
     {"u_alpha_V", 0, 16, true, 1, 10, 0.0f, "V", "stator voltage command, alpha"},
     {"u_beta_V", 16, 16, true, 1, 10, 0.0f, "V", "stator voltage command, beta"},
     {"sample", 32, 8, false, 1, 1, 0.0f, "", "telemetry sample count, wraps"},
+    {"rr_scale", 40, 16, false, 1, 10000, 0.0f, "",
+     "rotor resistance the drive runs on over the motor record's (tracked)"},
 };
 inline constexpr Signal kTimingSignals[] = {
     {"exec_mean_us", 0, 16, false, 1, 100, 0.0f, "us", "mean tick execution time"},
@@ -308,7 +310,7 @@ inline constexpr Message kMessages[] = {
      Timing::configurable, 10, "fast telemetry 1/3", kSpeedFluxSignals},
     {MessageId::telemetry_current, "telemetry_current", 8, Direction::drive_to_host,
      Timing::configurable, 10, "fast telemetry 2/3", kCurrentSignals},
-    {MessageId::telemetry_voltage, "telemetry_voltage", 5, Direction::drive_to_host,
+    {MessageId::telemetry_voltage, "telemetry_voltage", 7, Direction::drive_to_host,
      Timing::configurable, 10, "fast telemetry 3/3, sent last", kVoltageSignals},
     {MessageId::timing, "timing", 8, Direction::drive_to_host, Timing::cyclic, 100,
      "tick execution time at 10 Hz", kTimingSignals},

@@ -37,7 +37,7 @@ hal::CanFrame current(float i_A) {
   return encode_frame(kNode, MessageId::telemetry_current, {i_A, -2.5f, 0.75f, 300.1f});
 }
 hal::CanFrame voltage(float sample) {
-  return encode_frame(kNode, MessageId::telemetry_voltage, {12.3f, -45.6f, sample});
+  return encode_frame(kNode, MessageId::telemetry_voltage, {12.3f, -45.6f, sample, 1.05f});
 }
 
 TEST(drive_monitor_decode, NamesEnumeratedValues) {
@@ -89,10 +89,12 @@ TEST(drive_monitor_rows, EmitsARowWhenTheVoltageFrameArrives) {
   EXPECT_DOUBLE_EQ(row->v_bus_V, 3001 * 0.1);
   EXPECT_DOUBLE_EQ(row->u_beta_V, -456 * 0.1);
   EXPECT_EQ(row->sample, 42);
+  EXPECT_DOUBLE_EQ(row->rr_scale, 10500 * 1e-4);
   EXPECT_EQ(row->state, "running");
   EXPECT_EQ(row->first_fault, "none");
   EXPECT_EQ(csv_row(*row),
-            "0.010300,123.45,100.00,0.8100,0.8000,-1.23,-2.50,0.75,300.1,12.3,-45.6,42,running,"
+            "0.010300,123.45,100.00,0.8100,0.8000,-1.23,-2.50,0.75,300.1,12.3,-45.6,1.0500,42,"
+            "running,"
             "none");
   EXPECT_EQ(monitor.status().frames.rows, 1u);
   EXPECT_EQ(monitor.status().frames.stale_samples, 0u);
@@ -101,7 +103,7 @@ TEST(drive_monitor_rows, EmitsARowWhenTheVoltageFrameArrives) {
 TEST(drive_monitor_rows, CsvHeaderNamesTheColumns) {
   EXPECT_EQ(csv_header(),
             "time_s,speed_rad_s,speed_ref_rad_s,flux2_Wb2,flux2_ref_Wb2,iA_A,iB_A,load_Nm,"
-            "v_bus_V,u_alpha_V,u_beta_V,sample,state,first_fault");
+            "v_bus_V,u_alpha_V,u_beta_V,rr_scale,sample,state,first_fault");
 }
 
 TEST(drive_monitor_rows, CombinesTheLatestValuesAndCountsStaleAndIncompleteSamples) {

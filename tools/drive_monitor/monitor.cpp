@@ -75,6 +75,7 @@ constexpr std::size_t kVBus = index_of(MessageId::telemetry_current, "v_bus_V");
 constexpr std::size_t kUAlpha = index_of(MessageId::telemetry_voltage, "u_alpha_V");
 constexpr std::size_t kUBeta = index_of(MessageId::telemetry_voltage, "u_beta_V");
 constexpr std::size_t kSample = index_of(MessageId::telemetry_voltage, "sample");
+constexpr std::size_t kRrScale = index_of(MessageId::telemetry_voltage, "rr_scale");
 }  // namespace telemetry
 
 /// The CSV's telemetry columns, in order; their names are the signals' names.
@@ -89,6 +90,7 @@ constexpr const protocol::Signal* kColumns[] = {
     &signal_of(MessageId::telemetry_current, "v_bus_V"),
     &signal_of(MessageId::telemetry_voltage, "u_alpha_V"),
     &signal_of(MessageId::telemetry_voltage, "u_beta_V"),
+    &signal_of(MessageId::telemetry_voltage, "rr_scale"),
 };
 constexpr const protocol::Signal& kStateSignal = signal_of(MessageId::heartbeat, "state");
 constexpr const protocol::Signal& kFirstFaultSignal =
@@ -190,7 +192,8 @@ std::string csv_header() {
 std::string csv_row(const TelemetryRow& row) {
   const double values[] = {
       row.speed_rad_s, row.speed_ref_rad_s, row.flux2_Wb2, row.flux2_ref_Wb2, row.iA_A,
-      row.iB_A,        row.load_Nm,         row.v_bus_V,   row.u_alpha_V,     row.u_beta_V};
+      row.iB_A,        row.load_Nm,         row.v_bus_V,   row.u_alpha_V,     row.u_beta_V,
+      row.rr_scale};
   static_assert(std::size(values) == std::size(kColumns));
   char time[32];
   std::snprintf(time, sizeof time, "%.6f", row.time_s);
@@ -320,6 +323,7 @@ std::optional<TelemetryRow> DriveMonitor::on_voltage(double time_s, const Decode
   row.u_alpha_V = d.signals[telemetry::kUAlpha].value;
   row.u_beta_V = d.signals[telemetry::kUBeta].value;
   row.sample = static_cast<int>(d.signals[telemetry::kSample].raw);
+  row.rr_scale = d.signals[telemetry::kRrScale].value;
   const HeartbeatStatus& h = status_.heartbeat;
   if (h.count > 0) {
     row.state = enum_text(kStateSignal, h.state);

@@ -74,6 +74,7 @@ struct TelemetryRow {
   double u_alpha_V = 0.0;
   double u_beta_V = 0.0;
   int sample = 0;
+  double rr_scale = 0.0;    ///< tracked rotor resistance over the record's
   std::string state;        ///< from the latest heartbeat; empty before the first one
   std::string first_fault;  ///< likewise
 };

@@ -61,8 +61,16 @@ void wait_for_tick(const cm::TwoStageTick& timer) noexcept {
   cm::enable_interrupts();
 }
 
-int run(const sim::EmbeddedScenario& s, const DriveConfig& drive_config, cm::CmsdkUart& console) {
-  static sim::SimBoard board(s.plant, s.board);
+/// The plant of the scenario, its rotor resistance at `rr_percent` % of the scenario's.
+control::MotorParameters plant_of(const sim::EmbeddedScenario& s, int rr_percent) noexcept {
+  control::MotorParameters plant = s.plant;
+  plant.Rr_Ohm *= double(rr_percent) / 100.0;
+  return plant;
+}
+
+int run(const sim::EmbeddedScenario& s, const DriveConfig& drive_config, int plant_rr_percent,
+        cm::CmsdkUart& console) {
+  static sim::SimBoard board(plant_of(s, plant_rr_percent), s.board);
   board.set_load_profile(s.load);
   board.plant().set_state(s.initial_state);
   static sim::LookaheadReferences<float> references(s.references, s.drive.sample_period_s);
@@ -77,6 +85,7 @@ int run(const sim::EmbeddedScenario& s, const DriveConfig& drive_config, cm::Cms
   static sim::TickObserver<float> observer(
       sim::observed_run(s.references, s.settle_s, s.motor, drive_config));
   PilReport report(console);
+  static const mps2::FreeRunningTimer service_clock;
   report.start(s, drive_config, timer.counts_per_period());  // with the stack used so far: the start-up's
 
   const auto ticks = static_cast<uint64_t>(s.duration_s / s.board.period_s + 0.5);
@@ -94,7 +103,10 @@ int run(const sim::EmbeddedScenario& s, const DriveConfig& drive_config, cm::Cms
       if (k > 0) timer.resume();
       wait_for_tick(timer);
     });
+    const uint32_t retunes = drive.retunes();
+    const uint32_t service_start = service_clock.counts();
     drive.service();  // the main loop's out-of-tick work, between ticks
+    if (drive.retunes() != retunes) report.retuned(service_clock.counts() - service_start);
     const TickRecord<float>& rec = drive.record();
     while (board.can_side().take_sent(frame)) ++frames_sent;  // the host side reads the bus
     if (rec.stages_timed) stage_totals.add(rec.stage_counts);
@@ -144,5 +156,6 @@ int main() {
     console.write("\n");
     hal::cortex_m::semihosting_exit(2);
   }
-  hal::cortex_m::semihosting_exit(firmware::run(*options.scenario, options.drive, console));
+  hal::cortex_m::semihosting_exit(
+      firmware::run(*options.scenario, options.drive, options.plant_rr_percent, console));
 }

@@ -37,6 +37,17 @@ PilOptions parse_pil_options(std::string_view command_line,
         return o;
       }
       law_given = true;
+    } else if (word.starts_with("plant_rr_percent=")) {
+      word.remove_prefix(17);
+      int percent = 0;
+      for (const char c : word) {
+        percent = c >= '0' && c <= '9' && percent < 1000 ? percent * 10 + (c - '0') : 100000;
+      }
+      if (word.empty() || percent < 10 || percent > 500) {
+        o.error = "plant_rr_percent must be 10..500";
+        return o;
+      }
+      o.plant_rr_percent = percent;
     }
   }
   o.drive = o.scenario->drive;

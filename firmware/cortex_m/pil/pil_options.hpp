@@ -1,7 +1,9 @@
 #pragma once
 /// The processor-in-the-loop run's options, from the emulator's command line (semihosting):
-/// words "scenario=NAME" (one of the compiled-in scenarios) and "controller=NAME" (a law of
-/// firmware/laws/law_registry.hpp, instead of the scenario's); other words are ignored (the
+/// words "scenario=NAME" (one of the compiled-in scenarios), "controller=NAME" (a law of
+/// firmware/laws/law_registry.hpp, instead of the scenario's) and "plant_rr_percent=N" (the
+/// plant's rotor resistance at N % of the scenario's, 10..500: a mismatch the drive's
+/// rotor-resistance tracking retunes the model for); other words are ignored (the
 /// first is the program's name). tests/qemu/pil_test.py and tools/compare_controllers.py pass
 /// them as QEMU's -semihosting-config arg=... .
 #include <span>
@@ -15,6 +17,7 @@ namespace imd::firmware {
 struct PilOptions {
   const sim::EmbeddedScenario* scenario = nullptr;  ///< the first compiled in, by default
   DriveConfig drive;                                ///< the scenario's, the law replaced
+  int plant_rr_percent = 100;  ///< the plant's Rr over the scenario's, in percent
   const char* error = nullptr;  ///< a word that names nothing known: the run does not start
 };
 

@@ -65,6 +65,13 @@ int PilReport::finish(const Drive<float>& drive, const hal::cortex_m::TwoStageTi
        << exec.overruns << " can_frames_sent " << frames_sent << "\n";
   console_.write(line.view());
   line.clear();
+  // The model's rebuild on the tracked rotor resistance, in the main loop (service).
+  const uint64_t ns_per_count = 1000000000u / timer.execution_clock_Hz();
+  line << "pil retune count " << uint64_t(retunes_) << " ns_mean "
+       << (retunes_ > 0 ? retune_counts_total_ * ns_per_count / retunes_ : 0) << " ns_max "
+       << uint64_t(retune_counts_max_) * ns_per_count << "\n";
+  console_.write(line.view());
+  line.clear();
   line << "pil memory stack_used_bytes " << uint64_t(hal::cortex_m::stack_used_bytes())
        << " stack_size_bytes " << uint64_t(hal::cortex_m::stack_size_bytes()) << "\n";
   console_.write(line.view());

@@ -22,6 +22,13 @@ class PilReport {
   /// The scenario, the law that runs it and the stack used so far.
   void start(const sim::EmbeddedScenario& s, const DriveConfig& drive,
              uint32_t counts_per_period) noexcept;
+  /// A service call that rebuilt the model on the tracked rotor resistance took `counts` of
+  /// the execution clock.
+  void retuned(uint32_t counts) noexcept {
+    ++retunes_;
+    retune_counts_total_ += counts;
+    if (counts > retune_counts_max_) retune_counts_max_ = counts;
+  }
   /// Prints each stage's mean counts per tick.
   void stages(const sim::StageTotals& totals, uint32_t clock_Hz) noexcept;
   /// Prints the summary; returns the exit status (0: no fault, no overrun, metrics measured).
@@ -32,6 +39,8 @@ class PilReport {
   void metric(const char* name, double value) noexcept;
 
   hal::cortex_m::CmsdkUart& console_;
+  uint32_t retunes_ = 0, retune_counts_max_ = 0;
+  uint64_t retune_counts_total_ = 0;
 };
 
 }  // namespace imd::firmware
