@@ -150,8 +150,9 @@ void Drive<T>::retune() noexcept {
   }
   const MotorModel<T>& now = *models_[active_];
   const double estimate_Ohm = double(rr_estimate_Ohm_.load(std::memory_order_relaxed));
-  if (!(estimate_Ohm > 0.0) ||
-      std::abs(estimate_Ohm / now.motor.Rr_Ohm - 1.0) < config_.rr_retune_share) {
+  if (!(estimate_Ohm > 0.0) || (config_.rr_retune_share > 0.0 &&
+                                std::abs(estimate_Ohm / now.motor.Rr_Ohm - 1.0) <
+                                    config_.rr_retune_share)) {
     return;
   }
   const std::optional<control::MotorParameters> record = bank_.record();

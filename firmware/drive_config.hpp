@@ -76,7 +76,9 @@ struct DriveConfig {
   // a law runs, and the model is rebuilt on the estimate outside the tick.
   bool rotor_resistance_tracking = true;
   double rr_convergence_time_constant_s = 0.0;  ///< at slip tangent 1; 0: 4 tau_r
-  double rr_retune_share = 0.005;   ///< rebuild once the estimate is this far from the model
+  /// Rebuild once the estimate is this far from the model (0: at every interval, even on the
+  /// same value: what the tests use to exercise the swap).
+  double rr_retune_share = 0.005;
   double rr_retune_interval_s = 0.05;  ///< and no more often than this
 
   ProtectionConfig protection;

@@ -308,6 +308,10 @@ Scenario load_scenario(const std::filesystem::path& path, const std::vector<std:
   s.dead_time_compensation = r.boolean("drive.dead_time_compensation", true);
   s.rotor_resistance_tracking = r.boolean("drive.rotor_resistance_tracking", true);
   s.rr_convergence_time_constant_s = r.number("drive.rr_convergence_time_constant_s", 0.0);
+  s.rr_retune_share = r.number("drive.rr_retune_share", 0.005);
+  if (s.rr_retune_share < 0.0 || s.rr_retune_share > 0.5) {
+    r.fail("drive.rr_retune_share", fmt::format("= {}: must be in [0, 0.5]", s.rr_retune_share));
+  }
   if (s.rr_convergence_time_constant_s < 0.0 || s.rr_convergence_time_constant_s > 100.0) {
     r.fail("drive.rr_convergence_time_constant_s",
            fmt::format("= {}: must be in [0, 100] s (0: the rule)",

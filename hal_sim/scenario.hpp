@@ -92,6 +92,7 @@ struct Scenario {
   /// at slip tangent 1 (0: four rotor time constants).
   bool rotor_resistance_tracking = true;
   double rr_convergence_time_constant_s = 0.0;
+  double rr_retune_share = 0.005;  ///< rebuild the model when the estimate moved this much
 
   // [reference.speed], [reference.flux]
   SpeedProfile speed;

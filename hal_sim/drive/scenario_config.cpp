@@ -50,6 +50,7 @@ firmware::DriveConfig drive_config(const Scenario& s) {
   c.compensate_dead_time = s.dead_time_compensation;
   c.rotor_resistance_tracking = s.rotor_resistance_tracking;
   c.rr_convergence_time_constant_s = s.rr_convergence_time_constant_s;
+  c.rr_retune_share = s.rr_retune_share;
   c.max_accel_rad_s2 = s.max_accel_rad_s2;
   c.speed_reaching_pole = s.speed_reaching_pole;
   c.flux_reaching_pole = s.flux_reaching_pole;
