@@ -30,7 +30,7 @@ struct RotorResistanceMrasConfig {
   double convergence_time_constant_s = 0.0;
   /// Both powers are low-passed alike over this time (0: one rotor time constant).
   double filter_time_constant_s = 0.0;
-  double min_slip_tangent = 0.25;           ///< |x| below: frozen (no excitation)
+  double min_slip_tangent = 0.25;                             ///< |x| below: frozen (no excitation)
   double min_frequency_rad_s = 2.0 * 3.14159265358979 * 2.0;  ///< |w_e| below: frozen
   double min_scale = 0.3, max_scale = 3.0;  ///< the estimate stays within these x Rr
 };
@@ -90,8 +90,8 @@ class RotorResistanceMras {
     const T q_adapt_now = Lm_over_Lr_ * (p_ * omega_mech_rad_s * i_AB_A.dot(flux_AB_Wb_) -
                                          Rr_Ohm_ * inv_Lr_ * cross(i_AB_A, flux_AB_Wb_));
     const Vec2<T> i_mean_A = T(0.5) * (i_alphabeta_A + i_alphabeta_last_A_);
-    const T q_ref = cross(i_mean_A, u_alphabeta_V) -
-                    sigma_over_T_ * cross(i_alphabeta_last_A_, i_alphabeta_A);
+    const T q_ref =
+        cross(i_mean_A, u_alphabeta_V) - sigma_over_T_ * cross(i_alphabeta_last_A_, i_alphabeta_A);
     const T q_adapt = T(0.5) * (q_adapt_now + q_adapt_last_);
     q_ref_ += filter_ * (q_ref - q_ref_);
     q_adapt_ += filter_ * (q_adapt - q_adapt_);

@@ -53,8 +53,8 @@ Outcome run_motor(const test::TestMotor& tm, double tangent, double scale, doubl
   for (int k = 0; k < ticks; ++k) {
     const sim::PlantState& s = plant.state();
     const Rotation<double> rotor = Rotation<double>::from_angle(m.pole_pairs * s.theta_mech_rad);
-    mras.step(s.i_s_alphabeta_A, rotor.apply_inverse(s.i_s_alphabeta_A), s.omega_mech_rad_s,
-              u_last, true);
+    mras.step(s.i_s_alphabeta_A, rotor.apply_inverse(s.i_s_alphabeta_A), s.omega_mech_rad_s, u_last,
+              true);
     adapting += mras.adapting();
     // The voltage for [t_k, t_k+1], taken at the middle of the period (as SVPWM holds it).
     const Rotation<double> frame = Rotation<double>::from_angle(omega_e * (k + 0.5) * T);

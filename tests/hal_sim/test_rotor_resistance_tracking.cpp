@@ -61,11 +61,12 @@ TEST_P(Mismatch, TrackingRemovesWhatARotorResistanceErrorCosts) {
     const Summary on = run_scenario(scenario(c, {plant_rr}));
     const Summary off =
         run_scenario(scenario(c, {plant_rr, "drive.rotor_resistance_tracking=false"}));
-    std::printf("%s Rr x%.1f: speed rms %.4g (off %.4g, matched %.4g) rad/s, flux2 rms %.3g "
-                "(off %.3g) Wb^2, Rr %.5g of %.5g Ohm, %u retunes\n",
-                c.file, scale, on.speed_rms_err_rad_s, off.speed_rms_err_rad_s,
-                matched.speed_rms_err_rad_s, on.flux2_rms_err_Wb2, off.flux2_rms_err_Wb2,
-                on.rr_estimate_final_Ohm, on.plant_Rr_final_Ohm, on.rr_retunes);
+    std::printf(
+        "%s Rr x%.1f: speed rms %.4g (off %.4g, matched %.4g) rad/s, flux2 rms %.3g "
+        "(off %.3g) Wb^2, Rr %.5g of %.5g Ohm, %u retunes\n",
+        c.file, scale, on.speed_rms_err_rad_s, off.speed_rms_err_rad_s, matched.speed_rms_err_rad_s,
+        on.flux2_rms_err_Wb2, off.flux2_rms_err_Wb2, on.rr_estimate_final_Ohm,
+        on.plant_Rr_final_Ohm, on.rr_retunes);
     // The acceptance of docs/robustness.md: no faults, the estimate within 3 % of the plant's,
     // the speed error within 1.3x of the matched run's, the squared flux within 2 % of its
     // reference.
@@ -90,13 +91,14 @@ TEST(RotorHeating, TheEstimateFollowsTheRotorAsItHeatsUnderLoad) {
   // bound is 5 % after the first 2 s.
   for (const char* file : {"hal_sim/scenarios/seed000_realistic.toml",
                            "tests/data/scenarios/small_4pole_750W_realistic.toml"}) {
-    const Scenario s = load_scenario(test::source_path(file),
-                                     {"simulation.duration_s=20", "metrics.settle_s=2",
-                                      "plant.Rr_scale_end=1.5"});
+    const Scenario s =
+        load_scenario(test::source_path(file),
+                      {"simulation.duration_s=20", "metrics.settle_s=2", "plant.Rr_scale_end=1.5"});
     const Summary r = run_scenario(s);
-    std::printf("%s heating 1.0x -> 1.5x: largest estimate error after 2 s %.2f %%, final %.5g "
-                "of %.5g Ohm\n",
-                file, 100 * r.rr_rel_err_max, r.rr_estimate_final_Ohm, r.plant_Rr_final_Ohm);
+    std::printf(
+        "%s heating 1.0x -> 1.5x: largest estimate error after 2 s %.2f %%, final %.5g "
+        "of %.5g Ohm\n",
+        file, 100 * r.rr_rel_err_max, r.rr_estimate_final_Ohm, r.plant_Rr_final_Ohm);
     EXPECT_TRUE(r.faults.empty()) << file;
     EXPECT_NEAR(r.plant_Rr_final_Ohm / s.plant.Rr_Ohm, 1.5, 1e-3) << file;
     EXPECT_LT(r.rr_rel_err_max, 0.05) << file;
@@ -110,9 +112,9 @@ TEST(RotorResistanceSwap, AModelSwappedInOnTheSameResistanceChangesNothing) {
   // part must take its state over from the old model, so that the run is the same, bit for
   // bit, as one without a swap. A part that forgot a state (an integrator, an observer) would
   // show at once.
-  for (const char* file : {"hal_sim/scenarios/seed000_realistic.toml",
-                           "hal_sim/scenarios/seed001_realistic.toml",
-                           "hal_sim/scenarios/seed001_ifoc.toml"}) {
+  for (const char* file :
+       {"hal_sim/scenarios/seed000_realistic.toml", "hal_sim/scenarios/seed001_realistic.toml",
+        "hal_sim/scenarios/seed001_ifoc.toml"}) {
     Scenario s = load_scenario(test::source_path(file), {"simulation.duration_s=3"});
     s.motor.Rr_Ohm = s.plant.Rr_Ohm = double(float(s.motor.Rr_Ohm));
     s.rotor_resistance_tracking = false;
