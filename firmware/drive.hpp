@@ -100,6 +100,10 @@ class Drive final : public hal::TickHandler {
   std::optional<control::MotorParameters> motor() const noexcept;
   /// How often the service loop rebuilt the model on a tracked rotor resistance.
   uint32_t retunes() const noexcept { return retunes_; }
+  /// Whether the rotor resistance is tracked: configured, and the board's own power stage (a
+  /// substituted one, the paper's analog circuit or an ideal current source, does not report
+  /// the voltage it applies, which the tracker needs).
+  bool tracking_rotor_resistance() const noexcept { return tracking_; }
   const ParameterBank& parameters() const noexcept { return bank_; }
 
  private:

@@ -335,11 +335,10 @@ Scenario load_scenario(const std::filesystem::path& path, const std::vector<std:
     r.fail("simulation.duration_s", fmt::format("= {}: must be <= 3600 s", s.duration_s));
   // The windings' drift over the run (a rotor heating up): within what a copper or aluminium
   // winding does between -40 and 200 degC, with room on both sides.
-  s.Rs_scale_end = r.positive("plant.Rs_scale_end", 1.0);
-  s.Rr_scale_end = r.positive("plant.Rr_scale_end", 1.0);
-  for (const char* key : {"plant.Rs_scale_end", "plant.Rr_scale_end"}) {
-    const double scale = r.number(key, 1.0);
-    if (scale < 0.2 || scale > 5.0) r.fail(key, fmt::format("= {}: must be in [0.2, 5]", scale));
+  for (auto [key, scale] : {std::pair{"plant.Rs_scale_end", &s.Rs_scale_end},
+                             std::pair{"plant.Rr_scale_end", &s.Rr_scale_end}}) {
+    *scale = r.number(key, 1.0);
+    if (*scale < 0.2 || *scale > 5.0) r.fail(key, fmt::format("= {}: must be in [0.2, 5]", *scale));
   }
   s.substeps = static_cast<int>(r.integer("simulation.substeps", 10, 1, 10000));
   s.inner_feedback =

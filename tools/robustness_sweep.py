@@ -13,7 +13,11 @@ seed001_realistic.toml and the IFOC seed001_ifoc.toml (paper 001's 37 kW motor, 
 its slow rotor's estimate settles; metrics from 8 s). drive_sim runs them N at a time (default:
 every core) with a progress bar on standard error.
 
-Writes DIR/robustness.csv (one row per run) and DIR/robustness_<law>.png: for each map, with
+Writes DIR/robustness.csv (one row per run: law, tracking, map, the four plant/model ratios
+Rr_ratio, Rs_ratio, Lm_ratio, J_ratio, speed_rms_err_rad_s, flux2_rel (the squared-flux RMS
+error over its reference, a fraction), i_peak_A, rr_est_over_plant (the rotor resistance the
+drive ended on over the plant's; without tracking the model's), faults) and
+DIR/robustness_<law>.png: for each map, with
 and without tracking, the speed RMS error, the squared-flux RMS error over its reference and
 the peak current, each over the law's matched run (ratio 1 everywhere). A cell with a dot
 stays within 2x the matched error on both speed and flux; a cell marked F ended in a fault.
@@ -47,6 +51,8 @@ QUICK = {  # --quick: corners and centre only (a smoke test of the tool)
     "Rr_Rs": (("Rr_Ohm", [0.5, 1.0, 1.6]), ("Rs_Ohm", [0.7, 1.0, 1.3])),
     "Lm_J": (("Lm_H", [0.8, 1.0, 1.1]), ("J_kgm2", [0.5, 1.0, 3.0])),
 }
+# The CSV's columns for the ratios (plant over model, dimensionless).
+RATIO = {"Rr_Ohm": "Rr_ratio", "Rs_Ohm": "Rs_ratio", "Lm_H": "Lm_ratio", "J_kgm2": "J_ratio"}
 WITHIN = 2.0  # "stays within 2x its matched error"
 METRICS = [("speed_rms_err_rad_s", "speed RMS error"), ("flux2_rel", "squared-flux RMS error"),
            ("i_peak_A", "peak current")]
@@ -84,7 +90,7 @@ def run(job):
         args += ["--set", s]
     done = subprocess.run(args, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
     row = {"law": law, "tracking": tracking, "map": name}
-    row.update({key: ratios.get(key, 1.0) for key in ("Rr_Ohm", "Rs_Ohm", "Lm_H", "J_kgm2")})
+    row.update({RATIO[key]: ratios.get(key, 1.0) for key in RATIO})
     try:
         d = json.loads(pathlib.Path(summary).read_text())
     except (OSError, json.JSONDecodeError):
@@ -147,7 +153,7 @@ def plot(rows, maps, out):
                 if r["law"] != law or r["tracking"] != tracking:
                     continue
                 if r["map"] == name:
-                    i, j = ys.index(r[py]), xs.index(r[px])
+                    i, j = ys.index(r[RATIO[py]]), xs.index(r[RATIO[px]])
                 elif r["map"] == "matched":
                     i, j = ys.index(1.0), xs.index(1.0)
                 else:
@@ -182,12 +188,22 @@ def plot(rows, maps, out):
 
 
 def main():
-    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    p.add_argument("--drive-sim", default=str(ROOT / "build/bin/drive_sim"))
-    p.add_argument("--out", default=str(ROOT / "docs/img"))
-    p.add_argument("--jobs", type=int, default=os.cpu_count() or 1)
-    p.add_argument("--quick", action="store_true", help="3x3 corners only (a smoke test)")
+    p = argparse.ArgumentParser(
+        description="Robustness maps: each law's errors against plant/model parameter ratios, "
+        "with and without rotor-resistance tracking (docs/robustness.md).",
+        formatter_class=argparse.ArgumentDefaultsHelpFormatter)
+    p.add_argument("--drive-sim", default=str(ROOT / "build/bin/drive_sim"),
+                   help="the drive_sim binary")
+    p.add_argument("--out", default=None,
+                   help="where the CSV and PNGs go (default: docs/img, or with --quick "
+                   "/tmp/robustness_quick, so that a smoke test leaves the committed maps alone)")
+    p.add_argument("--jobs", type=int, default=os.cpu_count() or 1, help="runs at a time")
+    p.add_argument("--quick", action="store_true",
+                   help="3 x 3 ratios per map (the corners, the edges' middles and the centre): "
+                   "a smoke test")
     a = p.parse_args()
+    if a.out is None:
+        a.out = "/tmp/robustness_quick" if a.quick else str(ROOT / "docs/img")
     if not pathlib.Path(a.drive_sim).exists():
         raise SystemExit(f"robustness_sweep: no drive_sim at {a.drive_sim}: build it first "
                          "(cmake --build --preset host)")

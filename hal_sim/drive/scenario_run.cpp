@@ -146,6 +146,7 @@ Summary run(const Scenario& s, const RunCallbacks& callbacks) {
   summary.plant_Rr_final_Ohm = observer.plant_Rr_final_Ohm();
   summary.rr_rel_err_max = observer.rr_rel_err_max();
   summary.rr_retunes = drive.retunes();
+  summary.rr_tracking = drive.tracking_rotor_resistance();
   const double ns_per_count = 1e9 / double(drive.execution_clock_Hz());
   for (int i = 0; i < firmware::kStageCount; ++i) {
     summary.stage_ns_mean[i] = stages.ticks

@@ -46,6 +46,7 @@ struct Summary {
   /// after settle_s (NaN: none), and how often the model was rebuilt on the estimate.
   double rr_estimate_final_Ohm = 0.0, plant_Rr_final_Ohm = 0.0, rr_rel_err_max = 0.0;
   uint32_t rr_retunes = 0;
+  bool rr_tracking = false;  ///< tracking was on (configured, and the board's power stage)
   std::vector<FaultEvent> faults;
   /// A commissioning scenario's report (the run ends with the commissioning).
   std::optional<CommissioningReport> commissioning;

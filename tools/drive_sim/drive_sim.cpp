@@ -164,7 +164,7 @@ nlohmann::ordered_json summary_json(const imd::sim::Scenario& s, const imd::sim:
       {"torque_rms_err_Nm", r.torque_rms_err_Nm},
       {"i_hold_rms_err_A", r.i_hold_rms_err_A},
       {"i_peak_A", r.i_peak_A},
-      {"rotor_resistance_tracking", s.rotor_resistance_tracking},
+      {"rotor_resistance_tracking", r.rr_tracking},
       {"rr_estimate_final_Ohm", json_number(r.rr_estimate_final_Ohm)},
       {"plant_Rr_final_Ohm", json_number(r.plant_Rr_final_Ohm)},
       {"rr_rel_err_max", json_number(r.rr_rel_err_max)},
