@@ -15,8 +15,16 @@
 ///   * viscous friction enters xi1 through omega_decay (1 in the paper);
 ///   * an optional reaching law S_{k+1} = lambda S_k per channel (lambda = 0 is the paper's
 ///     deadbeat law S_{k+1} = 0), so that a board with a quantized encoder is not driven
-///     bang-bang by measurement noise.
+///     bang-bang by measurement noise;
+///   * the speed channel through the torque (DsmcSpeedChannel::torque, the default): w_alpha
+///     sets the torque product y = I^T J Phi of step k+1, which the exact model makes affine
+///     in v~ (the v~^T J v~ term vanishes), and the speed reaches its reference through it,
+///     e_{k+2} = pole e_{k+1}. The paper's channel sets w_{k+1} directly and so cancels the
+///     sampled system's zero near -1: the q current rings at half the sample rate
+///     (docs/control.md). DsmcSpeedChannel::paper keeps it, to reproduce the paper.
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 
 #include "control/voltage_fed_model.hpp"
@@ -25,6 +33,11 @@
 
 namespace imd::control {
 
+enum class DsmcSpeedChannel : uint8_t {
+  torque,  ///< the speed through the torque of the next step (no ringing)
+  paper,   ///< the speed of the next step directly, Section III (cancels the zero near -1)
+};
+
 struct DsmcConfig {
   /// B_k is refused (singular) when |det B_k| is below its value for a pure magnetizing state
   /// at this squared flux: det B_k ~ 2 b1 eta2 a11 |Phi~|^2.
@@ -32,6 +45,13 @@ struct DsmcConfig {
   /// Reaching laws e_{k+1} = pole e_k of the speed and squared-flux errors, in [0, 1).
   double speed_reaching_pole = 0.0;
   double flux_reaching_pole = 0.0;
+  DsmcSpeedChannel speed_channel = DsmcSpeedChannel::paper;
+  /// The torque channel's current pole: the torque and the flux's current approach their
+  /// targets as e_{k+1} = pole e_k (0: deadbeat, which passes the current's noise at
+  /// sigma Ls / delta volts per ampere).
+  double current_pole = 0.0;
+  /// The torque channel's largest |I^T J Phi| (the torque limit over 3/2 p Lm/Lr), A Wb.
+  double torque_product_limit_AWb = 1e300;
 };
 
 template <typename T>
@@ -69,7 +89,10 @@ class Dsmc {
   Dsmc(const VoltageFedCoefficients& c, const DsmcConfig& config) noexcept
       : a11_(T(c.a11)),
         a12_(T(c.a12)),
+        a21_(T(c.a21)),
+        a22_(T(c.a22)),
         b1_(T(c.b1)),
+        b2_(T(c.b2)),
         eta1_(T(c.eta1)),
         eta2_(T(c.eta2)),
         eta3_(T(c.eta3)),
@@ -77,20 +100,38 @@ class Dsmc {
         load_to_omega_(T(c.load_to_omega)),
         min_det_(T(std::abs(2.0 * c.b1 * c.eta2 * c.a11) * config.min_flux2_Wb2)),
         speed_pole_(T(config.speed_reaching_pole)),
-        flux_pole_(T(config.flux_reaching_pole)) {}
+        flux_pole_(T(config.flux_reaching_pole)),
+        torque_channel_(config.speed_channel == DsmcSpeedChannel::torque),
+        current_pole_(T(config.current_pole)),
+        y_limit_(T(std::min(config.torque_product_limit_AWb, 1e30))) {
+    // Through the current, det B_k ~ 2 q b2 a11^3 |Phi~|^2: its floor scales alike.
+    if (torque_channel_) {
+      const double q = c.a12 * c.b2 + c.a11 * c.b1;
+      min_det_ = T(std::abs(2.0 * q * c.b2 * c.a11 * c.a11 * c.a11) * config.min_flux2_Wb2);
+    }
+  }
 
   /// One step of the law. Tick context.
   DsmcOutput<T> step(const DsmcInput<T>& in) const noexcept {
     DsmcOutput<T> out;
     const Vec2<T>& flux = in.flux_r_AB_Wb;
     const Vec2<T>& current = in.i_s_AB_A;
-    // (7): lambda1^T v = (eta2 Phi + eta3 I)^T J v, i.e. lambda1 = -J (eta2 Phi + eta3 I).
-    const Vec2<T> g = eta2_ * flux + eta3_ * current;
-    const Vec2<T> lambda1 = -J_times(g);
     const Vec2<T> m = a11_ * flux + a12_ * current;  // flux at k+1 without input
-    const Vec2<T> lambda2 = (T(2) * b1_) * m;
+    const Vec2<T> n = a21_ * flux + a22_ * current;  // current at k+1 without input
+    // The speed row: the paper's (7), lambda1^T v = (eta2 Phi + eta3 I)^T J v; through the
+    // torque, y_{k+1} = (n + b2 v)^T J (m + b1 v) = n^T J m + (b1 n - b2 m)^T J v. Either way
+    // lambda1 = -J g.
+    const Vec2<T> g = torque_channel_ ? Vec2<T>(b1_ * n - b2_ * m)
+                                      : Vec2<T>(eta2_ * flux + eta3_ * current);
+    const Vec2<T> lambda1 = -J_times(g);
+    // The flux row: the paper's |Phi_{k+1}|^2 = |m + b1 v|^2; through the current, the flux
+    // one step later, |Phi_{k+2}|^2 = |p + q v|^2 with p = a11 m + a12 n, q = a11 b1 + a12 b2
+    // (the next input's own b1 share left out). Either way |base + gain v|^2.
+    const T gain = torque_channel_ ? a11_ * b1_ + a12_ * b2_ : b1_;
+    const Vec2<T> base = torque_channel_ ? Vec2<T>(a11_ * m + a12_ * n) : m;
+    const Vec2<T> lambda2 = (T(2) * gain) * base;
     const T xi1 = omega_decay_ * in.omega_mech_rad_s + eta1_ * dot_J(current, flux);
-    const T xi2 = m.squaredNorm();
+    const T xi2 = base.squaredNorm();
     // det [lambda1^T; lambda2^T] = g . lambda2.
     const T det = g.dot(lambda2);
     out.det_B = det;
@@ -101,15 +142,39 @@ class Dsmc {
     const T omega_target =
         in.omega_ref_next_rad_s + speed_pole_ * (in.omega_mech_rad_s - in.omega_ref_rad_s);
     const T flux2_target =
-        in.flux2_ref_next_Wb2 + flux_pole_ * (flux.squaredNorm() - in.flux2_ref_Wb2);
+        torque_channel_
+            ? T(2) * in.flux2_ref_next_Wb2 - in.flux2_ref_Wb2 +
+                  flux_pole_ * (m.squaredNorm() - in.flux2_ref_next_Wb2)
+            : in.flux2_ref_next_Wb2 + flux_pole_ * (flux.squaredNorm() - in.flux2_ref_Wb2);
     out.w_eq_alpha = omega_target - xi1 - load_to_omega_ * in.load_Nm;
+    if (torque_channel_) {
+      // w_{k+1} ~ xi1 + load term (v~'s own share, eta2 and eta3, is 1e-3 of it), and
+      // w_{k+2} = decay w_{k+1} + eta1 y_{k+1} + load term: the torque that puts w_{k+2} on
+      // its reference with the error e_{k+2} = pole e_{k+1}. The reference at k+2 is
+      // extrapolated from k and k+1 (exact on ramps).
+      const T omega_next = xi1 + load_to_omega_ * in.load_Nm;
+      const T omega_ref_after = T(2) * in.omega_ref_next_rad_s - in.omega_ref_rad_s;
+      const T target = omega_ref_after + speed_pole_ * (omega_next - in.omega_ref_next_rad_s);
+      const T y_ref = (target - omega_decay_ * omega_next - load_to_omega_ * in.load_Nm) / eta1_;
+      // The torque approaches it: y_{k+1} - y* = current_pole (y_k - y*).
+      const T y_now = dot_J(current, flux), y_target = std::clamp(y_ref, -y_limit_, y_limit_);
+      out.w_eq_alpha = y_target + current_pole_ * (y_now - y_target) - dot_J(n, m);
+    }
     const T lambda11 = lambda1.squaredNorm(), lambda22 = lambda2.squaredNorm();
     const T lambda12 = lambda1.dot(lambda2);
-    const T b1_over_det2 = b1_ * b1_ / (det * det);
+    const T b1_over_det2 = gain * gain / (det * det);
+    // Through the current, the flux's correction is taken at the current pole's pace too:
+    // measured from the flux the present current would give (held over the next period), a
+    // share current_pole of the correction is left to the next step.
+    const T flux2_aim =
+        torque_channel_
+            ? flux2_target + current_pole_ * ((a11_ * m + a12_ * current).squaredNorm() -
+                                              flux2_target)
+            : flux2_target;
     const auto flux_control = [&](T w_alpha, DsmcOutput<T>& o) {
       const T a = b1_over_det2 * lambda11;
       const T b = T(1) - T(2) * b1_over_det2 * w_alpha * lambda12;
-      const T c = xi2 - flux2_target + b1_over_det2 * w_alpha * w_alpha * lambda22;
+      const T c = xi2 - flux2_aim + b1_over_det2 * w_alpha * w_alpha * lambda22;
       o.c_k = c;
       o.discriminant = b * b - T(4) * a * c;
       return o.discriminant >= T(0) ? stable_root(a, b, c, o.discriminant) : -b / (T(2) * a);
@@ -184,9 +249,12 @@ class Dsmc {
     return {middle - half_chord * slope, middle + half_chord * slope};
   }
 
-  T a11_, a12_, b1_, eta1_, eta2_, eta3_, omega_decay_, load_to_omega_;
+  T a11_, a12_, a21_, a22_, b1_, b2_, eta1_, eta2_, eta3_, omega_decay_, load_to_omega_;
   T min_det_;
   T speed_pole_, flux_pole_;
+  bool torque_channel_;
+  T current_pole_;
+  T y_limit_;
 };
 
 }  // namespace imd::control

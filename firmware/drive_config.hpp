@@ -46,6 +46,11 @@ struct DriveConfig {
   double max_accel_rad_s2 = std::numeric_limits<double>::infinity();  ///< speed reference ramp
   double speed_reaching_pole = 0.0;  ///< e_{k+1} = pole e_k; 0 is the paper's deadbeat law
   double flux_reaching_pole = 0.0;
+  /// The DSMC's speed channel: through the torque of the next step (false, the default; its
+  /// speed error decays at dsmc_speed_bandwidth_rad_s), or the paper's, which sets the next
+  /// step's speed directly with speed_reaching_pole (true: to reproduce paper 000).
+  bool dsmc_paper_speed_channel = false;
+  double dsmc_speed_bandwidth_rad_s = 0.0;  ///< 0: the IFOC's rule (docs/control.md)
 
   // Limits.
   bool voltage_limited = true;      ///< false only to reproduce the paper (no limit)

@@ -306,6 +306,15 @@ Scenario load_scenario(const std::filesystem::path& path, const std::vector<std:
            fmt::format("= {}: must be below 0.1 * inverter.v_bus_V", s.inverter.device_drop_V));
   }
   s.dead_time_compensation = r.boolean("drive.dead_time_compensation", true);
+  s.dsmc_speed_channel = r.choice("drive.dsmc_speed_channel", "torque", {"torque", "paper"});
+  s.dsmc_speed_bandwidth_rad_s = r.number("drive.dsmc_speed_bandwidth_rad_s", 0.0);
+  if (s.dsmc_speed_bandwidth_rad_s < 0.0 ||
+      s.dsmc_speed_bandwidth_rad_s > 0.5 / s.sample_period_s) {
+    r.fail("drive.dsmc_speed_bandwidth_rad_s",
+           fmt::format("= {}: must be in [0, {}] rad/s (0: the rule; at most half the sample "
+                       "rate)",
+                       s.dsmc_speed_bandwidth_rad_s, 0.5 / s.sample_period_s));
+  }
   s.rotor_resistance_tracking = r.boolean("drive.rotor_resistance_tracking", true);
   s.rr_convergence_time_constant_s = r.number("drive.rr_convergence_time_constant_s", 0.0);
   s.rr_retune_share = r.number("drive.rr_retune_share", 0.005);

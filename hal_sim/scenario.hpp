@@ -88,6 +88,10 @@ struct Scenario {
   bool compensate_latency = true;    ///< predict over the PWM latency
   double speed_reaching_pole = 0.0;  ///< 0: the paper's deadbeat law
   double flux_reaching_pole = 0.0;
+  /// The DSMC's speed channel: "torque" (through the next step's torque) or "paper" (the
+  /// paper's, which sets the next speed directly; speed_reaching_pole applies to it).
+  std::string dsmc_speed_channel = "torque";
+  double dsmc_speed_bandwidth_rad_s = 0.0;  ///< torque channel; 0: the rule (docs/control.md)
   /// Track the rotor resistance online (docs/robustness.md); the adaptation's time constant
   /// at slip tangent 1 (0: four rotor time constants).
   bool rotor_resistance_tracking = true;

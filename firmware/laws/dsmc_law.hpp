@@ -1,6 +1,9 @@
 #pragma once
 /// The discrete sliding-mode law of paper 000 (control/dsmc.hpp) as the drive's law: speed and
 /// squared rotor flux, on the state predicted over the latency, within the feasible inputs.
+#include <algorithm>
+#include <cmath>
+
 #include "control/dsmc.hpp"
 #include "firmware/drive_config.hpp"
 #include "firmware/laws/control_law.hpp"
@@ -13,10 +16,47 @@ class DsmcLaw final : public ControlLaw<T> {
  public:
   static constexpr ControllerKind kKind = ControllerKind::dsmc;
 
-  explicit DsmcLaw(const LawContext& c) noexcept
-      : dsmc_(c.coefficients,
-              control::DsmcConfig{c.config.min_flux2_Wb2, c.config.speed_reaching_pole,
-                                  c.config.flux_reaching_pole}) {}
+  explicit DsmcLaw(const LawContext& c) noexcept : dsmc_(c.coefficients, dsmc_config(c)) {}
+
+  /// The law's settings: the paper's speed channel with its reaching pole, or the torque
+  /// channel with the pole of its speed bandwidth (docs/control.md). Construction only.
+  static control::DsmcConfig dsmc_config(const LawContext& c) noexcept {
+    control::DsmcConfig d;
+    d.min_flux2_Wb2 = c.config.min_flux2_Wb2;
+    d.flux_reaching_pole = c.config.flux_reaching_pole;
+    if (c.config.dsmc_paper_speed_channel) {
+      d.speed_channel = control::DsmcSpeedChannel::paper;
+      d.speed_reaching_pole = c.config.speed_reaching_pole;
+      return d;
+    }
+    d.speed_channel = control::DsmcSpeedChannel::torque;
+    const double speed_bandwidth_rad_s = dsmc_speed_bandwidth_rad_s(c.config);
+    d.speed_reaching_pole = std::exp(-speed_bandwidth_rad_s * c.config.sample_period_s);
+    // The flux loop a decade below the current's, as the speed loop's first bound: the load
+    // steps' cross-coupling is then corrected within a few milliseconds (the current disk
+    // bounds what a flux step asks of the d current).
+    const double flux_bandwidth_rad_s = current_bandwidth_rad_s(c.config) / 10.0;
+    d.flux_reaching_pole = std::exp(-flux_bandwidth_rad_s * c.config.sample_period_s);
+    // The current approaches its target at the IFOC's current bandwidth, f_s / 20 in rad/s
+    // (control/ifoc_design.hpp): pole e^{-pi/10} = 0.73 at any sample rate.
+    d.current_pole = std::exp(-current_bandwidth_rad_s(c.config) * c.config.sample_period_s);
+    const double torque_per_product =
+        control::kClarkeTorqueFactor * c.motor.pole_pairs * c.motor.Lm_H / c.motor.Lr_H;
+    d.torque_product_limit_AWb = c.config.torque_limit_Nm / torque_per_product;
+    return d;
+  }
+  /// The torque channel's speed bandwidth: the configured one, or the IFOC's rule
+  /// min(w_c / 10, w_obs / 4) with w_c = 2 pi f_s / 20 (control/ifoc_design.hpp): a decade below
+  /// what a current loop at this sample rate reaches, and a factor 4 below the speed estimate's
+  /// bandwidth.
+  static double dsmc_speed_bandwidth_rad_s(const DriveConfig& config) noexcept {
+    if (config.dsmc_speed_bandwidth_rad_s > 0.0) return config.dsmc_speed_bandwidth_rad_s;
+    return std::min(current_bandwidth_rad_s(config) / 10.0,
+                    config.encoder_observer_bandwidth_rad_s / 4.0);
+  }
+  static double current_bandwidth_rad_s(const DriveConfig& config) noexcept {
+    return 2.0 * 3.14159265358979 / config.sample_period_s / 20.0;
+  }
 
   /// The law keeps no state from tick to tick: nothing to take over from the one it replaces.
   void continue_from(const DsmcLaw& old) noexcept { (void)old; }

@@ -53,6 +53,8 @@ firmware::DriveConfig drive_config(const Scenario& s) {
   c.rr_retune_share = s.rr_retune_share;
   c.max_accel_rad_s2 = s.max_accel_rad_s2;
   c.speed_reaching_pole = s.speed_reaching_pole;
+  c.dsmc_paper_speed_channel = s.dsmc_speed_channel == "paper";
+  c.dsmc_speed_bandwidth_rad_s = s.dsmc_speed_bandwidth_rad_s;
   c.flux_reaching_pole = s.flux_reaching_pole;
   // Commands: a profile runs at once; over CAN the script enables the drive.
   c.commands_over_can = s.command_source == "can";

@@ -35,6 +35,9 @@ struct Summary {
   double torque_rms_err_Nm = 0.0;  ///< iol: torque against the law's command one T0 earlier
   double i_hold_rms_err_A = 0.0;   ///< iol: RMS of |i_AB - i_cmd| over the ticks
   double i_peak_A = 0.0, i_peak_total_A = 0.0;
+  /// The ripple at the control rate (f_s / 4 .. f_s / 2) after settle_s, RMS per phase
+  /// (hal_sim/drive/tick_observer.hpp).
+  double current_ripple_rms_A = 0.0, voltage_ripple_rms_V = 0.0;
   double saturated_fraction = 0.0;
   uint64_t ticks = 0;
   double simulated_s = 0.0, wall_time_s = 0.0;

@@ -97,6 +97,12 @@ class TickObserver {
   double rr_estimate_final_Ohm() const noexcept { return rr_final_Ohm_; }
   double plant_Rr_final_Ohm() const noexcept { return plant_Rr_final_Ohm_; }
   double rr_rel_err_max() const noexcept { return rr_rel_err_max_; }
+  /// The ripple at the control rate after settle_s: the RMS over the phases of
+  /// (x_{k+1} - 2 x_k + x_{k-1}) / 4, which passes a period-2 oscillation (f_s / 2) whole,
+  /// f_s / 4 at half, and nothing of a ramp; for the plant's phase currents at the samples and
+  /// the voltage it saw over each period. NaN: not measured.
+  double current_ripple_rms_A() const noexcept { return rms(ripple_i_sq_, ripple_count_); }
+  double voltage_ripple_rms_V() const noexcept { return rms(ripple_v_sq_, ripple_count_); }
 
  private:
   static double rms(double sum_sq, uint64_t n) noexcept {
@@ -111,6 +117,9 @@ class TickObserver {
   double running_from_s_ = -1.0;
   double rr_final_Ohm_ = std::nan(""), plant_Rr_final_Ohm_ = std::nan("");
   double rr_rel_err_max_ = std::nan("");
+  Vec2 i_last_[2] = {Vec2::Zero(), Vec2::Zero()}, v_last_[2] = {Vec2::Zero(), Vec2::Zero()};
+  uint64_t rows_seen_ = 0, ripple_count_ = 0;
+  double ripple_i_sq_ = 0.0, ripple_v_sq_ = 0.0;
   double torque_sq_ = 0, hold_sq_ = 0;
   uint64_t torque_count_ = 0, hold_count_ = 0;
   Vec2 boundary_flux_s_ = Vec2::Zero();       ///< true stator flux (rotor frame), last boundary
@@ -174,6 +183,22 @@ const SimRow& TickObserver<T>::observe(double t_s, const PlantState& truth, doub
   }
   row.saturated = rec.law.speed_saturated || rec.law.flux_saturated || rec.law.voltage_limited ||
                   rec.voltage_clipped;
+
+  // The ripple of the previous sample, now that its successor is known. For alpha-beta
+  // components the mean square over three phases is half of |x|^2.
+  const Vec2 i_now(row.i_alpha_A, row.i_beta_A), v_now(row.v_alpha_V, row.v_beta_V);
+  if (rows_seen_ >= 2 && t_s > run_.settle_s) {
+    const Vec2 ri = (i_now - 2.0 * i_last_[0] + i_last_[1]) / 4.0;
+    const Vec2 rv = (v_now - 2.0 * v_last_[0] + v_last_[1]) / 4.0;
+    ripple_i_sq_ += ri.squaredNorm() / 2.0;
+    ripple_v_sq_ += rv.squaredNorm() / 2.0;
+    ++ripple_count_;
+  }
+  i_last_[1] = i_last_[0];
+  i_last_[0] = i_now;
+  v_last_[1] = v_last_[0];
+  v_last_[0] = v_now;
+  ++rows_seen_;
 
   const bool running = rec.state == firmware::DriveState::running;
   if (running_from_s_ < 0 && running) running_from_s_ = t_s;

@@ -25,7 +25,7 @@ using imd::firmware::ControllerKind;
 using imd::firmware::DriveConfig;
 
 // A new field must be written here too: these sizes fail the build until it is.
-static_assert(sizeof(DriveConfig) == 440, "DriveConfig changed: write its new fields below");
+static_assert(sizeof(DriveConfig) == 456, "DriveConfig changed: write its new fields below");
 static_assert(sizeof(imd::sim::SimBoardConfig) == 152, "SimBoardConfig changed: write it below");
 static_assert(sizeof(imd::control::MotorParameters) == 64, "MotorParameters changed");
 
@@ -139,6 +139,8 @@ void write_drive(Writer& w, const DriveConfig& c) {
   w.number("drive.max_accel_rad_s2", c.max_accel_rad_s2);
   w.number("drive.speed_reaching_pole", c.speed_reaching_pole);
   w.number("drive.flux_reaching_pole", c.flux_reaching_pole);
+  w.boolean("drive.dsmc_paper_speed_channel", c.dsmc_paper_speed_channel);
+  w.number("drive.dsmc_speed_bandwidth_rad_s", c.dsmc_speed_bandwidth_rad_s);
   w.boolean("drive.rotor_resistance_tracking", c.rotor_resistance_tracking);
   w.number("drive.rr_convergence_time_constant_s", c.rr_convergence_time_constant_s);
   w.number("drive.rr_retune_share", c.rr_retune_share);
