@@ -168,6 +168,7 @@ def analyse(summary, csv, pole_pairs, case):
     r = {"speed_rms": summary["speed_rms_err_rad_s"], "speed_max": summary["speed_max_err_rad_s"],
          "ripple": band_rms(q_current(d, pole_pairs)[after], RIPPLE_BAND_HZ),
          "saturated": summary["saturated_fraction"], "i_peak": summary["i_peak_A"],
+         "i_ripple": summary["current_ripple_rms_A"], "v_ripple": summary["voltage_ripple_rms_V"],
          "faults": ", ".join(f["code"] for f in summary["faults"]) or "none",
          "law_ns": summary["stage_ns"]["law"], "tick_ns": summary["tick_exec_ns_mean"],
          # Plotted against the drive's own reference (after its ramp) while it runs.
@@ -219,15 +220,18 @@ def plot(results, path):
 
 def table(results, pil):
     rows = ["| case | law | speed RMS [rad/s] | peak error [rad/s] | q ripple 1-5 kHz [A] "
-            "| saturated | peak current [A] | faults |",
-            "|---|---|---|---|---|---|---|---|"]
+            "| current ripple [A] | voltage ripple [V] | saturated | peak current [A] | faults |",
+            "|---|---|---|---|---|---|---|---|---|---|"]
     for case in CASES:
         for law in LAWS:
             r = results[case][law]
             rows.append(f"| {case} | {law} | {r['speed_rms']:.3g} | {r['speed_max']:.3g} | "
-                        f"{r['ripple']:.3g} | {r['saturated']:.3f} | {r['i_peak']:.2f} | "
+                        f"{r['ripple']:.3g} | {r['i_ripple']:.3g} | {r['v_ripple']:.3g} | "
+                        f"{r['saturated']:.3f} | {r['i_peak']:.2f} | "
                         f"{r['faults']} |")
-    rows += ["", "Load step (50 rad/s, 0 -> 2 N m): the largest speed error after the step, and "
+    rows += ["", "Current and voltage ripple: the summary's control-rate ripple per phase, "
+             "f_s/4..f_s/2 (docs/control.md); the q ripple is the 1-5 kHz band of the "
+             "rotor-frame q current.", "", "Load step (50 rad/s, 0 -> 2 N m): the largest speed error after the step, and "
              "the time until the error stays within 2 % of the speed (0: it never left).", "",
              "| law | dip [rad/s] | recovery to 2 % [ms] |", "|---|---|---|"]
     for law in LAWS:
