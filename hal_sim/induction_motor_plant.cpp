@@ -1,7 +1,9 @@
 #include "hal_sim/induction_motor_plant.hpp"
 
+#include <algorithm>
 #include <bit>
 #include <cassert>
+#include <cmath>
 #include <numbers>
 
 #include "hal_sim/rk4.hpp"
@@ -119,6 +121,41 @@ void InductionMotorPlant::step_voltage(const Vec2& u_s_alphabeta_V,
         return u_s_alphabeta_V + error.error_V(constrained(x.segment<2>(2)));
       },
       load_Nm);
+}
+
+void InductionMotorPlant::step_voltage_segments(const VoltageSegment* segments,
+                                                std::size_t count, double load_Nm) noexcept {
+  const double h_max = config_.period_s / config_.rk4_substeps;
+  StateVector x = pack(state_);
+  // Integrals of I and |I|^2 over the period, the current taken linear over each step.
+  Vec2 sum_A_s = Vec2::Zero();
+  double sum_sq_A2_s = 0.0, total_s = 0.0;
+  Vec2 current = constrained(x.segment<2>(2));
+  for (std::size_t s = 0; s < count; ++s) {
+    const VoltageSegment& segment = segments[s];
+    const int steps = std::max(1, int(std::ceil(segment.duration_s / h_max - 1e-9)));
+    const double h = segment.duration_s / steps;
+    const auto rhs = [&](const StateVector& y) {
+      return voltage_fed_derivative(y, segment.u_alphabeta_V, load_Nm);
+    };
+    for (int i = 0; i < steps; ++i) {
+      x = integrate(x, h, 1, rhs);
+      const Vec2 next = constrained(x.segment<2>(2));
+      sum_A_s += 0.5 * h * (current + next);
+      // |I|^2 of the straight line between the two ends, integrated exactly (the trapezoid of
+      // the squares would count a ramp's square 3x over a step as long as the ramp).
+      sum_sq_A2_s +=
+          h * (current.squaredNorm() + current.dot(next) + next.squaredNorm()) / 3.0;
+      total_s += h;
+      current = next;
+    }
+  }
+  state_ = unpack(x);
+  time_s_ += config_.period_s;
+  if (total_s > 0.0) {
+    const Vec2 mean_A = sum_A_s / total_s;
+    period_ripple_sq_A2_ = std::max(sum_sq_A2_s / total_s - mean_A.squaredNorm(), 0.0);
+  }
 }
 
 namespace {

@@ -13,6 +13,7 @@
 /// Phases of the star-connected stator can be open (a fault): their current is then held at zero
 /// by their floating terminals (set_open_phases).
 #include <Eigen/Core>
+#include <cstddef>
 #include <optional>
 
 #include "control/frames.hpp"
@@ -43,6 +44,12 @@ class CurrentDependentVoltage {
 
  protected:
   ~CurrentDependentVoltage() = default;
+};
+
+/// A stretch of a period with a constant stator voltage (a switch state of the inverter).
+struct VoltageSegment {
+  double duration_s = 0.0;
+  Vec2 u_alphabeta_V = Vec2::Zero();
 };
 
 struct PlantConfig {
@@ -88,6 +95,15 @@ class InductionMotorPlant {
   void step_voltage(const Vec2& u_s_alphabeta_V, const CurrentDependentVoltage& error,
                     double load_Nm) noexcept;
 
+  /// One period as `count` segments of constant voltage (durations summing to the period),
+  /// each integrated with RK4 steps of at most period / rk4_substeps. Records the current's
+  /// ripple within the period (period_ripple_sq_A2).
+  void step_voltage_segments(const VoltageSegment* segments, std::size_t count,
+                             double load_Nm) noexcept;
+  /// Over the last step_voltage_segments period: the mean of |I(t) - I_mean|^2 (alpha-beta, the
+  /// current linear between integration steps); its half is the mean square per phase.
+  double period_ripple_sq_A2() const noexcept { return period_ripple_sq_A2_; }
+
   /// One period under the ideal analog inner feedback (2) of paper 000:
   /// u(t) = sigma p w J (I + beta Phi) + e^{p th(t) J} v~_k, evaluated at every RK4 stage.
   /// v~_k = e^{-p th_k J} v_k is the held rotor-frame input.
@@ -127,6 +143,7 @@ class InductionMotorPlant {
   PlantConfig config_;
   PlantState state_;
   double time_s_ = 0.0;
+  double period_ripple_sq_A2_ = 0.0;
   unsigned open_phases_ = 0;
   Vec2 open_axis_ = Vec2::Zero();  ///< axis of the open phase when exactly one is open
 };

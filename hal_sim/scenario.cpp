@@ -305,6 +305,8 @@ Scenario load_scenario(const std::filesystem::path& path, const std::vector<std:
     r.fail("inverter.device_drop_V",
            fmt::format("= {}: must be below 0.1 * inverter.v_bus_V", s.inverter.device_drop_V));
   }
+  s.switching_inverter =
+      r.choice("inverter.model", "average", {"average", "switching"}) == "switching";
   s.dead_time_compensation = r.boolean("drive.dead_time_compensation", true);
   s.dsmc_speed_channel = r.choice("drive.dsmc_speed_channel", "torque", {"torque", "paper"});
   s.dsmc_speed_bandwidth_rad_s = r.number("drive.dsmc_speed_bandwidth_rad_s", 0.0);

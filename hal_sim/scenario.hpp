@@ -126,6 +126,7 @@ struct Scenario {
   double i_max_A = 0.0;       ///< inf: no current limit
   bool limit_voltage = true;  ///< false: the law ignores the bus (the paper states no limit)
   InverterNonideality inverter;  ///< dead_time_s, device_drop_V
+  bool switching_inverter = false;  ///< [inverter] model = "switching" (else "average")
   bool dead_time_compensation = true;  ///< [drive]: the firmware adds the dead time back
 
   // [observers]

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "control/svpwm.hpp"
+#include "hal_sim/switching_inverter.hpp"
 
 namespace imd::sim {
 
@@ -95,6 +96,12 @@ void SimBoard::end_period() {
   } else if (config_.inner_feedback == InnerFeedback::ideal_analog) {
     applied_voltage_V_ = plant_.analog_feedback_voltage_V(active_analog_input_V_);
     plant_.step_analog_feedback(active_analog_input_V_, load_now_Nm);
+  } else if (config_.switching_inverter) {
+    const PwmPeriod pwm =
+        switching_period(config_.inverter, active_duty_, v_bus_V_, config_.period_s,
+                         now.i_s_alphabeta_A);
+    applied_voltage_V_ = pwm.average_V();
+    plant_.step_voltage_segments(pwm.segments.data(), pwm.count, load_now_Nm);
   } else if (config_.inverter.ideal()) {
     applied_voltage_V_ = inverter_output_V(active_duty_, v_bus_V_);
     plant_.step_voltage(applied_voltage_V_, load_now_Nm);

@@ -50,6 +50,9 @@ struct SimBoardConfig {
   bool current_source = false;  ///< the ideal current source drives the motor
   double v_bus_V = 311.0;       ///< nominal DC bus (a bus fault changes the board's v_bus_V())
   InverterNonideality inverter;  ///< dead time and device drop (PWM-driven motor only)
+  /// The inverter's switches over each period (switching_inverter.hpp) instead of its average:
+  /// the current ripple within the period is simulated (slower).
+  bool switching_inverter = false;
   uint32_t encoder_cpr = 8192;
   AdcModelConfig adc;
   uint64_t seed = 1;

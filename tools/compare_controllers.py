@@ -168,7 +168,7 @@ def analyse(summary, csv, pole_pairs, case):
     r = {"speed_rms": summary["speed_rms_err_rad_s"], "speed_max": summary["speed_max_err_rad_s"],
          "ripple": band_rms(q_current(d, pole_pairs)[after], RIPPLE_BAND_HZ),
          "saturated": summary["saturated_fraction"], "i_peak": summary["i_peak_A"],
-         "i_ripple": summary["current_ripple_rms_A"], "v_ripple": summary["voltage_ripple_rms_V"],
+         "i_ripple": summary["current_ripple_control_rms_A"], "v_ripple": summary["voltage_ripple_rms_V"],
          "faults": ", ".join(f["code"] for f in summary["faults"]) or "none",
          "law_ns": summary["stage_ns"]["law"], "tick_ns": summary["tick_exec_ns_mean"],
          # Plotted against the drive's own reference (after its ramp) while it runs.

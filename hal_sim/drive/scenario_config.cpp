@@ -21,6 +21,7 @@ SimBoardConfig board_config(const Scenario& s) {
   c.adc = s.adc;
   c.seed = s.seed;
   c.drift = {s.Rs_scale_end, s.Rr_scale_end, s.duration_s};
+  c.switching_inverter = s.switching_inverter;
   return c;
 }
 

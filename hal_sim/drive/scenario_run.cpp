@@ -147,8 +147,9 @@ Summary run(const Scenario& s, const RunCallbacks& callbacks) {
   summary.rr_rel_err_max = observer.rr_rel_err_max();
   summary.rr_retunes = drive.retunes();
   summary.rr_tracking = drive.tracking_rotor_resistance();
-  summary.current_ripple_rms_A = observer.current_ripple_rms_A();
+  summary.current_ripple_control_rms_A = observer.current_ripple_control_rms_A();
   summary.voltage_ripple_rms_V = observer.voltage_ripple_rms_V();
+  summary.current_ripple_rms_A = observer.current_ripple_rms_A();
   const double ns_per_count = 1e9 / double(drive.execution_clock_Hz());
   for (int i = 0; i < firmware::kStageCount; ++i) {
     summary.stage_ns_mean[i] = stages.ticks

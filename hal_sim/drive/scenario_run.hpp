@@ -37,7 +37,9 @@ struct Summary {
   double i_peak_A = 0.0, i_peak_total_A = 0.0;
   /// The ripple at the control rate (f_s / 4 .. f_s / 2) after settle_s, RMS per phase
   /// (hal_sim/drive/tick_observer.hpp).
-  double current_ripple_rms_A = 0.0, voltage_ripple_rms_V = 0.0;
+  double current_ripple_control_rms_A = 0.0, voltage_ripple_rms_V = 0.0;
+  /// With the switching inverter, the current's ripple within each period (NaN otherwise).
+  double current_ripple_rms_A = 0.0;
   double saturated_fraction = 0.0;
   uint64_t ticks = 0;
   double simulated_s = 0.0, wall_time_s = 0.0;

@@ -101,8 +101,11 @@ class TickObserver {
   /// (x_{k+1} - 2 x_k + x_{k-1}) / 4, which passes a period-2 oscillation (f_s / 2) whole,
   /// f_s / 4 at half, and nothing of a ramp; for the plant's phase currents at the samples and
   /// the voltage it saw over each period. NaN: not measured.
-  double current_ripple_rms_A() const noexcept { return rms(ripple_i_sq_, ripple_count_); }
+  double current_ripple_control_rms_A() const noexcept { return rms(ripple_i_sq_, ripple_count_); }
   double voltage_ripple_rms_V() const noexcept { return rms(ripple_v_sq_, ripple_count_); }
+  /// With the switching inverter: the RMS per phase of the current minus its average over each
+  /// period (the PWM's ripple, f_s and above), after settle_s. NaN with the average model.
+  double current_ripple_rms_A() const noexcept { return rms(pwm_ripple_sq_, pwm_ripple_count_); }
 
  private:
   static double rms(double sum_sq, uint64_t n) noexcept {
@@ -120,6 +123,8 @@ class TickObserver {
   Vec2 i_last_[2] = {Vec2::Zero(), Vec2::Zero()}, v_last_[2] = {Vec2::Zero(), Vec2::Zero()};
   uint64_t rows_seen_ = 0, ripple_count_ = 0;
   double ripple_i_sq_ = 0.0, ripple_v_sq_ = 0.0;
+  double pwm_ripple_sq_ = 0.0;
+  uint64_t pwm_ripple_count_ = 0;
   double torque_sq_ = 0, hold_sq_ = 0;
   uint64_t torque_count_ = 0, hold_count_ = 0;
   Vec2 boundary_flux_s_ = Vec2::Zero();       ///< true stator flux (rotor frame), last boundary
@@ -193,6 +198,10 @@ const SimRow& TickObserver<T>::observe(double t_s, const PlantState& truth, doub
     ripple_i_sq_ += ri.squaredNorm() / 2.0;
     ripple_v_sq_ += rv.squaredNorm() / 2.0;
     ++ripple_count_;
+  }
+  if (board.config().switching_inverter && t_s > run_.settle_s) {
+    pwm_ripple_sq_ += board.plant().period_ripple_sq_A2() / 2.0;
+    ++pwm_ripple_count_;
   }
   i_last_[1] = i_last_[0];
   i_last_[0] = i_now;

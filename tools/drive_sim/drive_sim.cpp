@@ -170,8 +170,9 @@ nlohmann::ordered_json summary_json(const imd::sim::Scenario& s, const imd::sim:
       {"rr_rel_err_max", json_number(r.rr_rel_err_max)},
       {"rr_retunes", r.rr_retunes},
       {"i_peak_total_A", r.i_peak_total_A},
-      {"current_ripple_rms_A", json_number(r.current_ripple_rms_A)},
+      {"current_ripple_control_rms_A", json_number(r.current_ripple_control_rms_A)},
       {"voltage_ripple_rms_V", json_number(r.voltage_ripple_rms_V)},
+      {"current_ripple_rms_A", json_number(r.current_ripple_rms_A)},
       {"i_max_A", std::isfinite(s.i_max_A) ? nlohmann::ordered_json(s.i_max_A)
                                            : nlohmann::ordered_json(nullptr)},
       {"saturated_fraction", r.saturated_fraction},

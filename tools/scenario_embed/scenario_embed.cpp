@@ -117,6 +117,7 @@ void write_board(Writer& w, const imd::sim::SimBoardConfig& b) {
   w.number("board.drift.Rs_scale_end", b.drift.Rs_scale_end);
   w.number("board.drift.Rr_scale_end", b.drift.Rr_scale_end);
   w.number("board.drift.duration_s", b.drift.duration_s);
+  w.boolean("board.switching_inverter", b.switching_inverter);
 }
 
 void write_drive(Writer& w, const DriveConfig& c) {

@@ -47,6 +47,7 @@ const sim::EmbeddedScenario kSeed000Realistic = [] {
   s.board.drift.Rs_scale_end = 1;
   s.board.drift.Rr_scale_end = 1;
   s.board.drift.duration_s = 8;
+  s.board.switching_inverter = false;
   s.drive.sample_period_s = 0.0001;
   s.drive.controller = ControllerKind::dsmc;
   s.drive.pwm_latency_ticks = 1;

@@ -47,6 +47,7 @@ const sim::EmbeddedScenario kSeed001Realistic = [] {
   s.board.drift.Rs_scale_end = 1;
   s.board.drift.Rr_scale_end = 1;
   s.board.drift.duration_s = 3;
+  s.board.switching_inverter = false;
   s.drive.sample_period_s = 0.0001;
   s.drive.controller = ControllerKind::iol;
   s.drive.pwm_latency_ticks = 1;
