@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "control/dsmc.hpp"
+#include "control/field_weakening.hpp"
 #include "firmware/drive_config.hpp"
 #include "firmware/laws/control_law.hpp"
 #include "firmware/laws/law_context.hpp"
@@ -16,7 +17,13 @@ class DsmcLaw final : public ControlLaw<T> {
  public:
   static constexpr ControllerKind kKind = ControllerKind::dsmc;
 
-  explicit DsmcLaw(const LawContext& c) noexcept : dsmc_(c.coefficients, dsmc_config(c)) {}
+  explicit DsmcLaw(const LawContext& c) noexcept
+      : dsmc_(c.coefficients, dsmc_config(c)),
+        fw_motor_{T(c.motor.Rs_Ohm), T(c.motor.Ls_H),
+                  T(c.motor.Ls_H - c.motor.Lm_H * c.motor.Lm_H / c.motor.Lr_H), T(c.motor.Lm_H)},
+        p_(T(c.motor.pole_pairs)),
+        slip_per_A_(T(c.motor.Rr_Ohm / c.motor.Lr_H * c.motor.Lm_H)),
+        min_flux2_(T(c.config.min_flux2_Wb2)) {}
 
   /// The law's settings: the paper's speed channel with its reaching pole, or the torque
   /// channel with the pole of its speed bandwidth (docs/control.md). Construction only.
@@ -65,6 +72,22 @@ class DsmcLaw final : public ControlLaw<T> {
   bool follows_speed() const noexcept override { return true; }
 
   LawOutput<T> step(const LawInput<T>& in, LawDiagnostics<T>& report) noexcept override {
+    // Field weakening: above base speed the squared-flux reference falls to what the voltage
+    // allows in steady state with the torque current flowing, never below the flux of the most
+    // torque per volt (control/field_weakening.hpp, the IFOC's rule), with a tenth of the disk
+    // left to the transients.
+    const control::Vec2<T>& flux_AB = in.e.x_input.flux_r_AB_Wb;
+    const T flux_Wb = std::max(flux_AB.norm(), std::sqrt(min_flux2_));
+    const T i_q = (flux_AB.x() * in.e.x_input.i_s_AB_A.y() -
+                   flux_AB.y() * in.e.x_input.i_s_AB_A.x()) / flux_Wb;
+    const T omega_e = p_ * in.e.x_input.omega_mech_rad_s + slip_per_A_ * i_q / flux_Wb;
+    const T v_fw = T(0.9) * in.v_max_V;
+    const T flux_limit =
+        std::max(control::voltage_limited_flux_Wb(fw_motor_, omega_e, i_q, v_fw),
+                 control::max_torque_per_volt_flux_Wb(fw_motor_, omega_e, v_fw));
+    const T flux2_limit = std::max(flux_limit * flux_limit, min_flux2_);
+    report.flux_ref_Wb = std::sqrt(std::min(in.next.flux2_Wb2, flux2_limit));
+
     control::DsmcInput<T> d;
     d.flux_r_AB_Wb = in.e.x_input.flux_r_AB_Wb;
     d.i_s_AB_A = in.e.x_input.i_s_AB_A;
@@ -72,8 +95,8 @@ class DsmcLaw final : public ControlLaw<T> {
     d.load_Nm = in.e.load_Nm;
     d.omega_ref_rad_s = in.now.omega_mech_rad_s;
     d.omega_ref_next_rad_s = in.next.omega_mech_rad_s;
-    d.flux2_ref_Wb2 = in.now.flux2_Wb2;
-    d.flux2_ref_next_Wb2 = in.next.flux2_Wb2;
+    d.flux2_ref_Wb2 = std::min(in.now.flux2_Wb2, flux2_limit);
+    d.flux2_ref_next_Wb2 = std::min(in.next.flux2_Wb2, flux2_limit);
     d.feasible = in.feasible;
     const control::DsmcOutput<T> out = dsmc_.step(d);
     report.discriminant = out.discriminant;
@@ -89,6 +112,8 @@ class DsmcLaw final : public ControlLaw<T> {
 
  private:
   control::Dsmc<T> dsmc_;
+  control::FieldWeakeningMotor<T> fw_motor_;
+  T p_, slip_per_A_, min_flux2_;
 };
 
 }  // namespace imd::firmware
