@@ -55,7 +55,8 @@ class RotorResistanceMras {
         Rr_min_Ohm_(T(c.min_scale * nominal_Rr_Ohm)),
         Rr_max_Ohm_(T(c.max_scale * nominal_Rr_Ohm)),
         inv_nominal_(T(1.0 / nominal_Rr_Ohm)),
-        Rr_Ohm_(T(motor.Rr_Ohm)) {}
+        Rr_Ohm_(T(std::clamp(motor.Rr_Ohm, c.min_scale * nominal_Rr_Ohm,
+                             c.max_scale * nominal_Rr_Ohm))) {}
 
   /// The rules' time constants for this motor (for documentation and the service loop).
   static double filter_s(const MotorParameters& m, const RotorResistanceMrasConfig& c) noexcept {
@@ -101,10 +102,21 @@ class RotorResistanceMras {
     const T omega_e = p_ * omega_mech_rad_s + tangent_ * Rr_Ohm_ * inv_Lr_;
     adapting_ = adapt && along_ > T(0) && std::abs(tangent_) >= min_tangent_ &&
                 std::abs(omega_e) >= min_frequency_ && q_adapt_ * omega_e > T(0);
-    if (adapting_) {
-      // Relative error of Q, bounded: one step moves the estimate by at most gain x 100 %.
-      const T relative = std::clamp((q_ref_ - q_adapt_) / q_adapt_, T(-1), T(1));
-      Rr_Ohm_ = std::clamp(Rr_Ohm_ * (T(1) + gain_ * relative), Rr_min_Ohm_, Rr_max_Ohm_);
+    const T relative = (q_ref_ - q_adapt_) / q_adapt_;
+    if (adapting_ && std::isfinite(relative)) {
+      // The relative step, bounded: one tick moves the estimate by at most gain x 100 %. The
+      // steps (gain ~ 1e-4 and less) are summed apart and applied once they reach 1e-4: in
+      // float, Rr (1 + step) would round a step below 6e-8 away and stall the estimate.
+      pending_ += gain_ * std::clamp(relative, T(-1), T(1));
+      if (std::abs(pending_) >= T(1e-4)) {
+        Rr_Ohm_ = std::clamp(Rr_Ohm_ * (T(1) + pending_), Rr_min_Ohm_, Rr_max_Ohm_);
+        pending_ = T(0);
+      }
+    }
+    if (!std::isfinite(q_ref_) || !std::isfinite(q_adapt_) || !std::isfinite(along_) ||
+        !std::isfinite(across_) || !std::isfinite(flux_AB_Wb_.x()) ||
+        !std::isfinite(flux_AB_Wb_.y())) {
+      reset_filters();  // a non-finite input must not stay in the filters
     }
     i_AB_last_A_ = i_AB_A;
     i_alphabeta_last_A_ = i_alphabeta_A;
@@ -125,9 +137,15 @@ class RotorResistanceMras {
     across_ = old.across_;
     tangent_ = old.tangent_;
     adapting_ = old.adapting_;
+    pending_ = old.pending_;
   }
 
  private:
+  void reset_filters() noexcept {
+    flux_AB_Wb_ = i_AB_last_A_ = i_alphabeta_last_A_ = Vec2<T>::Zero();
+    q_adapt_last_ = q_ref_ = q_adapt_ = along_ = across_ = tangent_ = pending_ = T(0);
+  }
+
   /// a x b = a_x b_y - a_y b_x (the reactive power of a current and a voltage).
   static T cross(const Vec2<T>& a, const Vec2<T>& b) noexcept {
     return a.x() * b.y() - a.y() * b.x();
@@ -140,6 +158,7 @@ class RotorResistanceMras {
   Vec2<T> i_AB_last_A_ = Vec2<T>::Zero(), i_alphabeta_last_A_ = Vec2<T>::Zero();
   T q_adapt_last_ = T(0), q_ref_ = T(0), q_adapt_ = T(0), along_ = T(0), across_ = T(0);
   T tangent_ = T(0);
+  T pending_ = T(0);  ///< relative steps not yet applied to Rr_Ohm_
   bool adapting_ = false;
 };
 

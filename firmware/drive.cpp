@@ -251,6 +251,7 @@ inline void Drive<T>::publish(uint64_t k, const Measurement<T>& m, const Estimat
     r.rr_adapting = model->rotor_resistance.adapting();
     r.rr_scale = model->rotor_resistance.scale();
     rr_estimate_Ohm_.store(static_cast<float>(r.rr_est_Ohm), std::memory_order_relaxed);
+    tick_published_.store(static_cast<uint32_t>(k), std::memory_order_relaxed);
     r.v_AB_V = v_applied_V_;
     r.omega_ref_rad_s = plan.next.omega_mech_rad_s;
     r.flux2_ref_Wb2 = plan.next.flux2_Wb2;

@@ -162,7 +162,8 @@ class Drive final : public hal::TickHandler {
   std::atomic<bool> retune_ready_{false};  ///< the other slot is whole: set by service
   MotorModel<T>* attached_;        ///< tick side: the model in use, null while none
   std::atomic<float> rr_estimate_Ohm_{0.0f};  ///< the tick's latest estimate, for the service
-  uint64_t last_retune_tick_ = 0;
+  std::atomic<uint32_t> tick_published_{0};  ///< the tick count, for the service loop's pace
+  uint32_t last_retune_tick_ = 0;
   uint32_t retunes_ = 0;
   bool tracking_;  ///< the tracker may move Rr (config, and a power stage that knows its voltage)
   /// Planned by the service loop on an identify command, then run by the tick.

@@ -26,16 +26,19 @@ void Drive<T>::service() noexcept {
       bank_.applied();
       return;
     case ParameterBank::Stage::free:
-    case ParameterBank::Stage::answered:
       retune();
+      return;
+    case ParameterBank::Stage::answered:  // a staged record may be on its way: no retune now
       return;
   }
 }
 
 template <typename T>
 void Drive<T>::rebuild(const control::MotorParameters& motor) noexcept {
-  // The tick has let go of every model (it swaps only while attached).
+  // The tick has let go of every model (it swaps only while attached). The last estimate was
+  // the old model's: forgotten, so that no retune undoes the new record's Rr.
   retune_ready_.store(false, std::memory_order_relaxed);
+  rr_estimate_Ohm_.store(0.0f, std::memory_order_relaxed);
   models_[active_ ^ 1].reset();
   models_[active_].reset();
   models_[active_].emplace(motor, config_, board_);
@@ -48,8 +51,9 @@ void Drive<T>::retune() noexcept {
       retune_ready_.load(std::memory_order_acquire)) {
     return;  // not tracking, no model, or the last retune not yet taken
   }
-  const uint64_t k = hw_.timer.tick_count();
-  if (double(k - last_retune_tick_) * config_.sample_period_s < config_.rr_retune_interval_s) {
+  const uint32_t k = tick_published_.load(std::memory_order_relaxed);
+  if (double(uint32_t(k - last_retune_tick_)) * config_.sample_period_s <
+      config_.rr_retune_interval_s) {
     return;
   }
   const MotorModel<T>& now = *models_[active_];

@@ -15,7 +15,10 @@
 /// isolated: the Clarke transform of the pole voltages is the stator voltage.
 ///
 /// The period splits at the legs' edges into at most 7 segments of constant voltage, which the
-/// plant integrates one after the other (InductionMotorPlant::step_voltage_segments).
+/// plant integrates one after the other (InductionMotorPlant::step_voltage_segments). Limits:
+/// an edge delayed past the period's end (duty above 1 - 2 t_d / T with a negative current) is
+/// cut at the end, not carried into the next period; at zero current the dead time is taken as
+/// for a positive one.
 #include <array>
 #include <cstddef>
 
