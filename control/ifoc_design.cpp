@@ -13,11 +13,11 @@ IfocGains design_ifoc(const MotorParameters& motor, const IfocSpec& spec) {
   g.sample_period_s = T;
   g.current_bandwidth_rad_s = spec.current_bandwidth_rad_s > 0.0
                                   ? spec.current_bandwidth_rad_s
-                                  : 2.0 * std::numbers::pi / (20.0 * T);
-  g.speed_bandwidth_rad_s =
-      spec.speed_bandwidth_rad_s > 0.0
-          ? spec.speed_bandwidth_rad_s
-          : std::min(g.current_bandwidth_rad_s / 10.0, spec.speed_feedback_bandwidth_rad_s / 4.0);
+                                  : default_current_bandwidth_rad_s(T);
+  g.speed_bandwidth_rad_s = spec.speed_bandwidth_rad_s > 0.0
+                                ? spec.speed_bandwidth_rad_s
+                                : default_speed_bandwidth_rad_s(
+                                      g.current_bandwidth_rad_s, spec.speed_feedback_bandwidth_rad_s);
 
   // One axis after the feed-forward: i(k+1) = a i(k) + b u(k).
   const double a = std::exp(-k.gamma_per_s * T);

@@ -56,6 +56,18 @@ struct IfocGains {
   int latency_ticks = 1;
 };
 
+/// The rules' bandwidths (also the DSMC's torque channel's, docs/control.md): the current loop
+/// at f_s / 20 in rad/s; the speed loop at min(w_c / 10, w_obs / 4). Construction only.
+constexpr double default_current_bandwidth_rad_s(double sample_period_s) noexcept {
+  return 2.0 * 3.141592653589793 / (20.0 * sample_period_s);
+}
+constexpr double default_speed_bandwidth_rad_s(double current_bandwidth_rad_s,
+                                               double speed_feedback_bandwidth_rad_s) noexcept {
+  return current_bandwidth_rad_s / 10.0 < speed_feedback_bandwidth_rad_s / 4.0
+             ? current_bandwidth_rad_s / 10.0
+             : speed_feedback_bandwidth_rad_s / 4.0;
+}
+
 /// The gains for a valid motor and spec (sample period > 0).
 IfocGains design_ifoc(const MotorParameters& motor, const IfocSpec& spec);
 

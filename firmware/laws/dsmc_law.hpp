@@ -6,6 +6,7 @@
 
 #include "control/dsmc.hpp"
 #include "control/field_weakening.hpp"
+#include "control/ifoc_design.hpp"
 #include "firmware/drive_config.hpp"
 #include "firmware/laws/control_law.hpp"
 #include "firmware/laws/law_context.hpp"
@@ -58,11 +59,11 @@ class DsmcLaw final : public ControlLaw<T> {
   /// bandwidth.
   static double dsmc_speed_bandwidth_rad_s(const DriveConfig& config) noexcept {
     if (config.dsmc_speed_bandwidth_rad_s > 0.0) return config.dsmc_speed_bandwidth_rad_s;
-    return std::min(current_bandwidth_rad_s(config) / 10.0,
-                    config.encoder_observer_bandwidth_rad_s / 4.0);
+    return control::default_speed_bandwidth_rad_s(current_bandwidth_rad_s(config),
+                                                  config.encoder_observer_bandwidth_rad_s);
   }
   static double current_bandwidth_rad_s(const DriveConfig& config) noexcept {
-    return 2.0 * 3.14159265358979 / config.sample_period_s / 20.0;
+    return control::default_current_bandwidth_rad_s(config.sample_period_s);
   }
 
   /// The law keeps no state from tick to tick: nothing to take over from the one it replaces.
