@@ -2,7 +2,8 @@
 
 #include <Eigen/Core>
 #include <cmath>
-#include <unsupported/Eigen/MatrixFunctions>
+
+#include "control/block_exponential.hpp"
 
 namespace imd::control {
 
@@ -32,7 +33,7 @@ VoltageFedCoefficients discretize_voltage_fed(const MotorParameters& motor, doub
 
   // Electrical part: A_d and B_d are blocks of exp(A3 delta).
   const Eigen::Matrix3d a3 = voltage_fed_axis_generator(motor);
-  const Eigen::Matrix3d e3 = (a3 * delta_s).exp();
+  const Eigen::Matrix3d e3 = block_exponential<double>(a3 * delta_s, 0.0).e_x;
   c.a11 = e3(0, 0);
   c.a12 = e3(0, 1);
   c.a21 = e3(1, 0);
@@ -49,15 +50,11 @@ VoltageFedCoefficients discretize_voltage_fed(const MotorParameters& motor, doub
   //   Z = int_0^delta exp(M u) (1 - exp(-f (delta - u))) / f du  (-> (delta - u) as f -> 0).
   // Built in the dimensionless time u/delta, so that the three blocks are of one size:
   // exp([M delta, I, 0; 0, -f delta I, I; 0, 0, 0]) holds Y / delta and Z / delta^2.
-  const Eigen::Matrix3d m = additive_compound(a3);
-  Eigen::Matrix<double, 9, 9> big = Eigen::Matrix<double, 9, 9>::Zero();
-  big.block<3, 3>(0, 0) = m * delta_s;
-  big.block<3, 3>(0, 3).setIdentity();
-  big.block<3, 3>(3, 3) = -friction_per_s * delta_s * Eigen::Matrix3d::Identity();
-  big.block<3, 3>(3, 6).setIdentity();
-  const Eigen::Matrix<double, 9, 9> e9 = big.exp();
-  const Eigen::Matrix3d y = delta_s * e9.block<3, 3>(0, 3);
-  const Eigen::Matrix3d z = delta_s * delta_s * e9.block<3, 3>(0, 6);
+  // block_exponential computes exactly this structured exponential without forming the 9x9.
+  const BlockExponential<double> van_loan =
+      block_exponential<double>(additive_compound(a3) * delta_s, -friction_per_s * delta_s);
+  const Eigen::Matrix3d y = delta_s * van_loan.y;
+  const Eigen::Matrix3d z = delta_s * delta_s * van_loan.z;
   // q = m00 I^T J Phi - m01 Phi^T J v - m02 I^T J v, with m the first row of exp(M t).
   c.eta1 = k.mu_per_kgm2 * y(0, 0);
   c.eta2 = -k.mu_per_kgm2 * y(0, 1);
@@ -71,7 +68,7 @@ VoltageFedCoefficients discretize_voltage_fed(const MotorParameters& motor, doub
   mech(0, 1) = 1.0;
   mech(1, 1) = -friction_per_s;
   mech(1, 2) = -1.0 / motor.J_kgm2;
-  const Eigen::Matrix3d e_mech = (mech * delta_s).exp();
+  const Eigen::Matrix3d e_mech = block_exponential<double>(mech * delta_s, 0.0).e_x;
   c.omega_decay = e_mech(1, 1);
   c.omega_decay_minus_one = std::expm1(-friction_per_s * delta_s);
   c.omega_to_theta_s = e_mech(0, 1);

@@ -34,9 +34,9 @@ struct VoltageFedCoefficients {
   double load_to_theta = 0.0;          ///< coefficient of C_L in th_{k+1}, rad per N m
 };
 
-/// Computes the coefficients numerically exactly from matrix exponentials (Eigen's
-/// MatrixFunctions). Not for tick context: call once at start-up. Requires valid parameters
-/// and delta_s > 0.
+/// Computes the coefficients numerically exactly from structured matrix exponentials
+/// (control/block_exponential.hpp: a few hundred multiply-adds, no allocation). Not for tick
+/// context: start-up and the service loop. Requires valid parameters and delta_s > 0.
 VoltageFedCoefficients discretize_voltage_fed(const MotorParameters& motor, double delta_s);
 
 /// Generator of one axis of the rotor-frame dynamics (5) with the held input as a third state:

@@ -4,7 +4,7 @@
 /// magnetizer, the input limits, the modulator's inner feedback and the checks that need the
 /// motion model. It is built whole from one record, outside the tick (at construction, or by
 /// Drive::service after a parameter write), and the tick uses it only while it is complete.
-/// Building it costs the matrix exponential of the discretization and the laws' designs: far
+/// Building it costs the structured exponentials of the discretization and the laws' designs: far
 /// more than a tick, which is why it is never done in one. While the drive runs, a model on a
 /// new rotor resistance replaces it at a tick boundary and takes over its state
 /// (continue_from), so that the tracked Rr reaches every part (docs/robustness.md).

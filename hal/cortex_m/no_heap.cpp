@@ -2,10 +2,9 @@
 ///
 /// There is no heap. operator new is deliberately left undefined, so any allocation by new
 /// fails to link, and so does any throw (cmake/CortexM.cmake). The C allocator is wrapped
-/// (--wrap=malloc, ...) to the traps below: Eigen's fixed-size algorithms used at start-up (the
-/// matrix exponential of the exact discretization) name aligned_malloc as the fallback for a
-/// temporary larger than EIGEN_STACK_ALLOCATION_LIMIT (128 KiB), which their 3x3 and 9x9
-/// matrices never need; newlib's allocator is therefore never linked, and a call would be a
+/// (--wrap=malloc, ...) to the traps below: Eigen's fixed-size algorithms name aligned_malloc as
+/// the fallback for a temporary larger than EIGEN_STACK_ALLOCATION_LIMIT (128 KiB), which
+/// their small fixed-size matrices never need; newlib's allocator is therefore never linked, and a call would be a
 /// fatal fault. tools/check_tick_path.py proves that the tick cannot reach any of them.
 #include <cstddef>
 
