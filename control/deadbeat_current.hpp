@@ -18,7 +18,12 @@ class DeadbeatCurrent {
 
   Vec2<T> input(const Vec2<T>& flux_r_AB_Wb, const Vec2<T>& i_s_AB_A, const Vec2<T>& i_target_AB_A,
                 const InputDisk<T>& feasible) const noexcept {
-    return feasible.clamp((i_target_AB_A - a21_ * flux_r_AB_Wb - a22_ * i_s_AB_A) / b2_);
+    return feasible.clamp(wanted(flux_r_AB_Wb, i_s_AB_A, i_target_AB_A));
+  }
+  /// The input that reaches the target in one period, before the limits.
+  Vec2<T> wanted(const Vec2<T>& flux_r_AB_Wb, const Vec2<T>& i_s_AB_A,
+                 const Vec2<T>& i_target_AB_A) const noexcept {
+    return (i_target_AB_A - a21_ * flux_r_AB_Wb - a22_ * i_s_AB_A) / b2_;
   }
 
  private:

@@ -81,6 +81,7 @@ struct DsmcOutput {
   T det_B = T(0);
   bool speed_saturated = false;
   bool flux_saturated = false;
+  bool torque_clamped = false;  ///< torque channel: the torque limit cut its torque
 };
 
 template <typename T>
@@ -158,6 +159,7 @@ class Dsmc {
       const T y_ref = (target - omega_decay_ * omega_next - load_to_omega_ * in.load_Nm) / eta1_;
       // The torque approaches it: y_{k+1} - y* = current_pole (y_k - y*).
       const T y_now = dot_J(current, flux), y_target = std::clamp(y_ref, -y_limit_, y_limit_);
+      out.torque_clamped = y_target != y_ref;
       out.w_eq_alpha = y_target + current_pole_ * (y_now - y_target) - dot_J(n, m);
     }
     const T lambda11 = lambda1.squaredNorm(), lambda22 = lambda2.squaredNorm();

@@ -49,6 +49,7 @@ struct IfocOutput {
   T flux_ref_Wb = T(0);                  ///< after field weakening
   bool torque_limited = false;           ///< the current limit trimmed the torque
   bool voltage_limited = false;          ///< the PI voltage was outside the disk
+  bool torque_clamped = false;           ///< the speed PI's torque limit cut its output
 };
 
 template <typename T>
@@ -102,6 +103,7 @@ class Ifoc {
     const T feedforward = J_over_T_ * (in.omega_ref_next_rad_s - in.omega_ref_rad_s) +
                           friction_ * in.omega_ref_next_rad_s;
     out.torque_ref_Nm = speed_pi_.step(in.omega_ref_rad_s, in.omega_mech_rad_s, feedforward);
+    out.torque_clamped = speed_pi_.saturated();
     const T i_q_max = std::sqrt(std::max(i_limit_ * i_limit_ - i_d_ref * i_d_ref, T(0)));
     const T i_q_wanted = out.torque_ref_Nm / (kt_ * flux);
     const T i_q_ref = std::clamp(i_q_wanted, -i_q_max, i_q_max);

@@ -43,7 +43,8 @@ Drive<T>::Drive(const std::optional<MotorRecord>& record, const DriveConfig& con
                   config.compensate_latency && config.pwm_latency_ticks > 0,
                   config.adc_calibration_ticks <= 0),
       clock_Hz_(peripherals.timer.execution_clock_Hz()),
-      ns_per_count_(static_cast<float>(1e9 / double(clock_Hz_))) {
+      ns_per_count_(static_cast<float>(1e9 / double(clock_Hz_))),
+      limited_(limited_window_ticks(config)) {
   protection_.set_clock(clock_Hz_);
   hw_.pwm.disable();
 }
@@ -158,15 +159,21 @@ inline LawOutput<T> Drive<T>::law(const TickPlan<T>& plan, const Estimate<T>& e,
                                   MotorModel<T>* model) noexcept {
   record_.law.speed_saturated = record_.law.flux_saturated = record_.law.iol_boundary = false;
   record_.law.voltage_limited = false;
+  record_.law.limit = Limitation::none;
   // The commissioning drives the motor itself; a law would run on no estimate.
   if (plan.mode == Mode::off || plan.mode == Mode::identifying || model == nullptr) return {};
   const control::InputDisk<T> feasible = model->limits.feasible(e.x_input, v_bus_V);
   if (plan.mode == Mode::magnetizing) {
     return model->magnetizer.step(e.x_input, plan.next, supervisor_.controlled_flux(), feasible);
   }
-  return supervisor_.law().step({e, plan.now, plan.next, plan.ahead, plan.stopping, feasible,
-                                 model->limits.v_max_V(v_bus_V)},
-                                record_.law);
+  const LawOutput<T> out =
+      supervisor_.law().step({e, plan.now, plan.next, plan.ahead, plan.stopping, feasible,
+                              model->limits.v_max_V(v_bus_V)},
+                             record_.law);
+  if (record_.law.limit == Limitation::input) {
+    record_.law.limit = model->limits.binding(e.x_input, v_bus_V, out.v_AB_V);
+  }
+  return out;
 }
 
 template <typename T>
@@ -261,6 +268,13 @@ inline void Drive<T>::publish(uint64_t k, const Measurement<T>& m, const Estimat
   }
   DriveStatus& status = supervisor_.status();
   status.state = supervisor_.state();
+  if (status.state == DriveState::running) {
+    limited_.update(record_.law.limit);
+  } else {
+    limited_.reset();  // stopping, stopped or faulted: nothing to reach
+  }
+  status.limited = limited_.limited();
+  r.limited = status.limited;
   status.command_counter = supervisor_.decoder().last_counter();
   status.rejected_commands = supervisor_.decoder().rejected_total();
   r.state = status.state;

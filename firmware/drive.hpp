@@ -19,6 +19,7 @@
 #include "firmware/execution_stats.hpp"
 #include "firmware/identification/commissioning.hpp"
 #include "firmware/laws/law_registry.hpp"
+#include "firmware/limitation.hpp"
 #include "firmware/motor_model.hpp"
 #include "firmware/parameters/parameter_bank.hpp"
 #include "firmware/protection/protection.hpp"
@@ -182,6 +183,7 @@ class Drive final : public hal::TickHandler {
   int ticks_since_timed_ = 0;  ///< for the stage timing of one tick in N
   TickRecord<T> record_;
   ExecutionStats execution_;
+  LimitedMonitor limited_;  ///< whether a limit holds the running drive back
 };
 
 }  // namespace imd::firmware

@@ -26,6 +26,7 @@ struct DriveStatus {
   uint8_t command_counter = 0;
   uint32_t rejected_commands = 0;
   bool can_bus_off = false;
+  Limitation limited = Limitation::none;  ///< a limit holds the running drive back
   // The last commissioning run: its step (kIdentifyStepValues; 6 none yet), progress and end.
   uint8_t identify_step = 6;
   float identify_fraction = 0.0f;

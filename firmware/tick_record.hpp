@@ -39,6 +39,7 @@ struct TickRecord {
   Vec2 i_cmd_AB_A = Vec2::Zero();     ///< current command (magnetizing, current-fed law)
   bool voltage_clipped = false;
   LawDiagnostics<T> law;
+  Limitation limited = Limitation::none;  ///< held for the monitor's window (limitation.hpp)
   // Execution time: the tick up to the PWM write, and each stage in execution-clock counts,
   // measured on the ticks with stages_timed (publish's only after the record was sent).
   uint32_t exec_ns = 0;

@@ -8,6 +8,7 @@
 
 #include "control/frames.hpp"
 #include "control/input_disk.hpp"
+#include "firmware/limitation.hpp"
 #include "firmware/reference_source.hpp"
 #include "firmware/stages/estimate.hpp"
 
@@ -38,6 +39,9 @@ struct LawOutput {
 /// A law writes its own fields; the record holds them from tick to tick.
 template <typename T>
 struct LawDiagnostics {
+  /// This tick: the limit that cut what the law's speed or flux channel wanted, the feasible
+  /// input set first (Limitation::input), then the current, then the torque limit.
+  Limitation limit = Limitation::none;
   // The sliding-mode law.
   T discriminant = T(0), c_k = T(0), det_B = T(0);
   bool speed_saturated = false, flux_saturated = false;  ///< this tick

@@ -105,6 +105,9 @@ class DsmcLaw final : public ControlLaw<T> {
     report.det_B = out.det_B;
     report.speed_saturated = out.speed_saturated;
     report.flux_saturated = out.flux_saturated;
+    report.limit = out.speed_saturated || out.flux_saturated ? Limitation::input
+                   : out.torque_clamped                     ? Limitation::torque
+                                                            : Limitation::none;
     LawOutput<T> result;
     result.v_AB_V = out.v_AB_V;
     result.ok = out.status == control::DsmcStatus::ok;

@@ -65,6 +65,10 @@ class IfocLaw final : public ControlLaw<T> {
     report.flux_ref_Wb = out.flux_ref_Wb;
     report.slip_rad_s = ifoc_.flux_model().slip_rad_s();
     report.voltage_limited = out.voltage_limited;
+    report.limit = out.voltage_limited  ? Limitation::voltage
+                   : out.torque_limited ? Limitation::current
+                   : out.torque_clamped ? Limitation::torque
+                                        : Limitation::none;
     LawOutput<T> result;
     result.v_AB_V = out.u_AB_V - inner_V;
     result.i_cmd_AB_A = out.i_ref_AB_A;

@@ -33,12 +33,17 @@ class IolLaw final : public ControlLaw<T> {
   }
 
   LawOutput<T> step(const LawInput<T>& in, LawDiagnostics<T>& report) noexcept override {
-    const IolTickResult<T> r = stage_.tick(in.e.x.flux_r_AB_Wb, in.e.x.omega_mech_rad_s, in.ahead);
+    const IolTickResult<T> r =
+        stage_.tick(in.e.x.flux_r_AB_Wb, in.e.x.omega_mech_rad_s, in.ahead, in.v_max_V);
     LawOutput<T> out;
     out.ok = r.status == control::IolStatus::ok;
     out.i_cmd_AB_A = r.i_cmd_AB_A;
-    out.v_AB_V = current_loop_.input(in.e.x_input.flux_r_AB_Wb, in.e.x_input.i_s_AB_A, r.i_cmd_AB_A,
-                                     in.feasible);
+    const control::Vec2<T> wanted =
+        current_loop_.wanted(in.e.x_input.flux_r_AB_Wb, in.e.x_input.i_s_AB_A, r.i_cmd_AB_A);
+    out.v_AB_V = in.feasible.clamp(wanted);
+    report.limit = !in.feasible.contains(wanted) ? Limitation::input
+                   : r.torque_held_back         ? Limitation::torque
+                                                : Limitation::none;
     report.i_held_AB_A = r.i_held_AB_A;
     report.iol_boundary = r.boundary;
     if (r.boundary) {

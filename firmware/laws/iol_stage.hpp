@@ -6,7 +6,9 @@
 /// v1 comes from the reference or an outer speed PI; v2 from (21) or the outer flux loop.
 /// Tick context except the constructor.
 #include <cmath>
+#include <algorithm>
 #include <cstdint>
+#include <limits>
 
 #include "control/current_fed_model.hpp"
 #include "control/flux_outer_loop.hpp"
@@ -29,6 +31,9 @@ struct IolTickResult {
   T y2_ref = T(0), y2 = T(0);                    ///< v2, and y2(k) from the flux estimates
   T flux2_s_Wb2 = T(0);                          ///< |phi_s|^2 at this boundary
   bool torque_limited = false;
+  /// The torque of the period in force was cut: by the speed PI's torque limit or by the
+  /// law's guard (every tick, from the boundary that decided it).
+  bool torque_held_back = false;
 };
 
 template <typename T>
@@ -49,6 +54,9 @@ class IolStage {
         outer_flux_loop_(config.outer_flux_loop),
         sigma_H_(T(motor.Ls_H - motor.Lm_H * motor.Lm_H / motor.Lr_H)),
         Lm_over_Lr_(T(motor.Lm_H / motor.Lr_H)),
+        Rs_Ohm_(T(motor.Rs_Ohm)),
+        p_(T(motor.pole_pairs)),
+        slip_per_A_(T(motor.Rr_Ohm * motor.Lm_H / motor.Lr_H)),
         one_minus_flux_decay_(T(1) - T(coefficients_.flux_decay)) {}
 
   const control::CurrentFedCoefficients& coefficients() const noexcept { return coefficients_; }
@@ -61,12 +69,13 @@ class IolStage {
     flux_s_before_.setZero();
     flux_loop_.reset();
     speed_pi_.reset();
+    torque_held_back_ = false;
   }
 
   /// One tick while running. `flux_r_AB_Wb` and `omega` are the estimates at this tick;
   /// `ref_next` is the reference for the next T0 boundary.
   IolTickResult<T> tick(const control::Vec2<T>& flux_r_AB_Wb, T omega_mech_rad_s,
-                        const Reference<T>& ref_next) noexcept {
+                        const Reference<T>& ref_next, T v_max_V) noexcept {
     IolTickResult<T> r;
     if (ticks_++ % ticks_per_period_ == 0) {
       // A boundary: the current computed one period ago, u(k-1) = i(t_k), is imposed now and
@@ -79,6 +88,7 @@ class IolStage {
     // reaches its target one tick after it acts), latency ticks for an ideal current source.
     const auto phase = int((ticks_ - 1) % uint64_t(ticks_per_period_));
     r.i_held_AB_A = i_held_;
+    r.torque_held_back = torque_held_back_;
     r.i_cmd_AB_A = (!r.boundary && ticks_per_period_ - phase <= lead_ticks_) ? i_next_ : i_held_;
     if (!r.boundary) return r;
     // The stator flux just after the current stepped to the held value (15).
@@ -89,7 +99,8 @@ class IolStage {
     r.torque_ref_Nm = outer_speed_loop_
                           ? speed_pi_.step(ref_next.omega_mech_rad_s, omega_mech_rad_s)
                           : ref_next.torque_Nm;
-    const T flux2_ref = ref_next.stator_flux2_Wb2;
+    const T flux2_ref = std::min(ref_next.stator_flux2_Wb2,
+                                 voltage_limited_flux2_Wb2(flux_r_AB_Wb, omega_mech_rad_s, v_max_V));
     r.y2_ref = outer_flux_loop_ ? flux_loop_.step(flux2_ref, r.flux2_s_Wb2)
                                 : one_minus_flux_decay_ * flux2_ref;  // (21)
     const control::IolOutput<T> out = law_.step({flux_s, i_held_, r.torque_ref_Nm, r.y2_ref});
@@ -97,8 +108,27 @@ class IolStage {
     r.torque_cmd_Nm = out.torque_cmd_Nm;
     r.torque_limited = out.torque_limited;
     if (out.torque_limited && outer_speed_loop_) speed_pi_.undo_last_integration();
+    torque_held_back_ = out.torque_limited || (outer_speed_loop_ && speed_pi_.saturated());
     i_next_ = out.i_next_AB_A;
     return r;
+  }
+
+  /// Field weakening: the squared stator flux the voltage allows in steady state with the
+  /// current held, |u| <= Rs |i| + w_e |phi_s| <= 0.9 v_max (the DSMC's and the IFOC's tenth
+  /// left to the transients), w_e the flux frequency: p w plus the rotor-flux model's slip
+  /// Rr Lm i_q / (Lr |phi_r|). +inf without a voltage limit or at standstill.
+  T voltage_limited_flux2_Wb2(const control::Vec2<T>& flux_r_AB_Wb, T omega_mech_rad_s,
+                              T v_max_V) const noexcept {
+    const T flux_r = flux_r_AB_Wb.norm();
+    if (!(v_max_V < std::numeric_limits<T>::infinity()) || !(flux_r > T(0))) {
+      return std::numeric_limits<T>::infinity();
+    }
+    const T i_q = (flux_r_AB_Wb.x() * i_held_.y() - flux_r_AB_Wb.y() * i_held_.x()) / flux_r;
+    const T omega_e = std::abs(p_ * omega_mech_rad_s + slip_per_A_ * i_q / flux_r);
+    const T v_left = std::max(T(0.9) * v_max_V - Rs_Ohm_ * i_held_.norm(), T(0));
+    if (!(omega_e > T(0))) return std::numeric_limits<T>::infinity();
+    const T flux_s = v_left / omega_e;
+    return flux_s * flux_s;
   }
 
   /// Takes over the state of the object this one replaces (the same motor but for its
@@ -110,6 +140,7 @@ class IolStage {
     i_next_ = old.i_next_;
     flux_s_before_ = old.flux_s_before_;
     ticks_ = old.ticks_;
+    torque_held_back_ = old.torque_held_back_;
   }
 
  private:
@@ -121,11 +152,13 @@ class IolStage {
   int lead_ticks_;  ///< ticks before a boundary at which u(k) is commanded
   bool outer_speed_loop_, outer_flux_loop_;
   T sigma_H_, Lm_over_Lr_;
+  T Rs_Ohm_, p_, slip_per_A_;
   T one_minus_flux_decay_;  ///< 1 - e^{-eta T0}, in T (the tick converts nothing)
   control::Vec2<T> i_held_ = control::Vec2<T>::Zero();  ///< imposed over this period, u(k-1)
   control::Vec2<T> i_next_ = control::Vec2<T>::Zero();  ///< for the next period, u(k)
   control::Vec2<T> flux_s_before_ = control::Vec2<T>::Zero();
   uint64_t ticks_ = 0;
+  bool torque_held_back_ = false;
 };
 
 }  // namespace imd::firmware

@@ -103,6 +103,8 @@ inline constexpr ValueName kFaultValues[] = {
     {15, "enable_input"},
 };
 inline constexpr ValueName kControllerValues[] = {{0, "dsmc"}, {1, "iol"}, {2, "ifoc"}};
+inline constexpr ValueName kLimitedValues[] = {
+    {0, "none"}, {1, "voltage"}, {2, "current"}, {3, "torque"}};
 inline constexpr ValueName kCommandResultValues[] = {
     {0, "accepted"},      {1, "wrong_length"}, {2, "bad_crc"},     {3, "repeated_counter"},
     {4, "stale_counter"}, {5, "out_of_range"}, {6, "not_allowed"}, {7, "unknown_message"},
@@ -153,7 +155,11 @@ inline constexpr Signal kHeartbeatSignals[] = {
     {"command_counter", 40, 4, false, 1, 1, 0.0f, "", "alive counter of the last accepted command"},
     {"controller", 44, 2, false, 1, 1, 0.0f, "", "selected controller", kControllerValues},
     {"can_bus_off", 46, 1, false, 1, 1, 0.0f, "", "the CAN controller was bus-off"},
-    {"rejected_commands", 48, 8, false, 1, 1, 0.0f, "", "rejected command frames, wraps"},
+    {"rejected_commands", 48, 6, false, 1, 1, 0.0f, "",
+     "rejected command frames, wraps at 64 (command_ack carries the 16-bit total)"},
+    {"limited", 54, 2, false, 1, 1, 0.0f, "",
+     "the limit that holds the running drive from its reference (firmware/limitation.hpp)",
+     kLimitedValues},
     {"transitions", 56, 8, false, 1, 1, 0.0f, "", "state transitions, wraps"},
 };
 inline constexpr Signal kFaultReportSignals[] = {

@@ -12,6 +12,7 @@
 #include "control/motor_parameters.hpp"
 #include "control/svpwm.hpp"
 #include "control/voltage_fed_model.hpp"
+#include "firmware/limitation.hpp"
 
 namespace imd::firmware {
 
@@ -71,6 +72,20 @@ class InputLimits {
       current = {-(a21_ * x.flux_r_AB_Wb + a22_ * x.i_s_AB_A) / b2_, current_limit_A_ / b2_};
     }
     return control::inscribed_disk(voltage, current);
+  }
+
+  /// Which of the two limits an input v~ on the edge of the feasible set presses against: the
+  /// disk it is nearer to leaving, measured as the share of each radius it uses, so that volts
+  /// and amperes compare (the inscribed disk touches each only at one point). Not in the tick's
+  /// common path: only on ticks where the law reports the input limited.
+  Limitation binding(const control::RotorFrameState<T>& x, T v_bus_V,
+                     const control::Vec2<T>& v_AB_V) const noexcept {
+    if (!current_limited_) return Limitation::voltage;
+    if (!voltage_limited_) return Limitation::current;
+    const T voltage_share = (v_AB_V + feedback_.compensation_AB_V(x)).norm() / v_max_V(v_bus_V);
+    const T current_share =
+        (a21_ * x.flux_r_AB_Wb + a22_ * x.i_s_AB_A + b2_ * v_AB_V).norm() / current_limit_A_;
+    return current_share > voltage_share ? Limitation::current : Limitation::voltage;
   }
 
  private:

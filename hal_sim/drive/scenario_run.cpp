@@ -51,6 +51,7 @@ Summary run(const Scenario& s, const RunCallbacks& callbacks) {
   std::vector<hal::CanFrame> sent_frames;  // reused: no allocation per tick
   CommissioningWatch commissioning(s.sample_period_s);
   uint16_t last_fault_bits = 0;
+  firmware::Limitation last_limited = firmware::Limitation::none;
   bool diverged = false;
   for (uint64_t k = 0; k < ticks; ++k) {
     const double t_s = double(k) * s.sample_period_s;
@@ -103,6 +104,14 @@ Summary run(const Scenario& s, const RunCallbacks& callbacks) {
       awaiting_pwm_off.push_back(event);
     }
     last_fault_bits = rec.fault_bits;
+    if (rec.limited != firmware::Limitation::none) summary.limited_total_s += s.sample_period_s;
+    if (rec.limited != last_limited) {  // the last span ends; a new one may start
+      if (last_limited != firmware::Limitation::none) summary.limited->to_s = t_s;
+      if (rec.limited != firmware::Limitation::none) {
+        summary.limited = LimitedSpan{firmware::limitation_name(rec.limited), t_s, std::nan("")};
+      }
+      last_limited = rec.limited;
+    }
     if (!board.pwm().enabled()) {
       for (const std::size_t event : awaiting_pwm_off) summary.faults[event].pwm_off_at_s = t_s;
       awaiting_pwm_off.clear();

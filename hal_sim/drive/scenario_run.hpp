@@ -26,6 +26,14 @@ struct FaultEvent {
   double pwm_off_at_s = std::nan("");
 };
 
+/// A span of time in which a limit held the running drive from its reference
+/// (firmware/limitation.hpp). to_s is NaN when it still held at the end of the run.
+struct LimitedSpan {
+  std::string reason;  ///< "voltage", "current" or "torque"
+  double from_s = 0.0;
+  double to_s = std::nan("");
+};
+
 /// Metrics over t > settle_s from the plant's true state (i_peak_total_A: the whole run). NaN
 /// when the run ended before settle_s.
 struct Summary {
@@ -53,6 +61,9 @@ struct Summary {
   uint32_t rr_retunes = 0;
   bool rr_tracking = false;  ///< tracking was on (configured, and the board's power stage)
   std::vector<FaultEvent> faults;
+  /// The last limitation of the run, if there was one, and the time limited in all.
+  std::optional<LimitedSpan> limited;
+  double limited_total_s = 0.0;
   /// A commissioning scenario's report (the run ends with the commissioning).
   std::optional<CommissioningReport> commissioning;
 };

@@ -43,6 +43,7 @@ struct SimRow {
   bool iol_boundary = false;
   int state = 0;
   bool saturated = false;
+  int limited = 0;  ///< the drive's `limited` (firmware::Limitation: 0 none, 1 voltage, ...)
 };
 
 /// What the rows and the metrics take from the scenario.
@@ -188,6 +189,7 @@ const SimRow& TickObserver<T>::observe(double t_s, const PlantState& truth, doub
   }
   row.saturated = rec.law.speed_saturated || rec.law.flux_saturated || rec.law.voltage_limited ||
                   rec.voltage_clipped;
+  row.limited = static_cast<int>(rec.limited);
 
   // The ripple of the previous sample, now that its successor is known. For alpha-beta
   // components the mean square over three phases is half of |x|^2.

@@ -28,7 +28,8 @@ constexpr uint8_t kNode = 1;
 
 hal::CanFrame heartbeat(float state, float first_fault = 0.0f, float command_counter = 0.0f) {
   return encode_frame(kNode, MessageId::heartbeat,
-                      {state, 0.0f, first_fault, 7.0f, command_counter, 1.0f, 0.0f, 2.0f, 3.0f});
+                      {state, 0.0f, first_fault, 7.0f, command_counter, 1.0f, 0.0f, 2.0f, 1.0f,
+                       3.0f});
 }
 hal::CanFrame speed_flux(float speed_rad_s) {
   return encode_frame(kNode, MessageId::telemetry_speed_flux, {speed_rad_s, 100.0f, 0.81f, 0.8f});
@@ -43,13 +44,14 @@ hal::CanFrame voltage(float sample) {
 TEST(drive_monitor_decode, NamesEnumeratedValues) {
   const DecodedFrame d = decode_frame(heartbeat(3.0f, 2.0f), kNode);
   ASSERT_EQ(d.kind, FrameKind::decoded);
-  ASSERT_EQ(d.signal_count, 9u);
+  ASSERT_EQ(d.signal_count, 10u);
   EXPECT_STREQ(d.signals[0].signal->name, "state");
   EXPECT_STREQ(d.signals[0].value_name, "running");
   EXPECT_STREQ(d.signals[2].value_name, "overcurrent");
   EXPECT_EQ(describe(d),
             "heartbeat state=running fault_bits=0 first_fault=overcurrent counter=7 "
-            "command_counter=0 controller=iol can_bus_off=0 rejected_commands=2 transitions=3");
+            "command_counter=0 controller=iol can_bus_off=0 rejected_commands=2 limited=voltage "
+            "transitions=3");
 }
 
 TEST(drive_monitor_decode, SortsOutOtherNodesUnknownIdsAndWrongLengths) {

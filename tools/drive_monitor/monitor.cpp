@@ -31,6 +31,7 @@ constexpr std::size_t kCommandCounter = index_of(MessageId::heartbeat, "command_
 constexpr std::size_t kController = index_of(MessageId::heartbeat, "controller");
 constexpr std::size_t kBusOff = index_of(MessageId::heartbeat, "can_bus_off");
 constexpr std::size_t kRejected = index_of(MessageId::heartbeat, "rejected_commands");
+constexpr std::size_t kLimited = index_of(MessageId::heartbeat, "limited");
 constexpr std::size_t kTransitions = index_of(MessageId::heartbeat, "transitions");
 }  // namespace heartbeat
 
@@ -243,6 +244,7 @@ std::optional<TelemetryRow> DriveMonitor::feed(double time_s, const hal::CanFram
       h.controller = raw(heartbeat::kController);
       h.can_bus_off = raw(heartbeat::kBusOff) != 0;
       h.rejected_commands = raw(heartbeat::kRejected);
+      h.limited = raw(heartbeat::kLimited);
       h.transitions = raw(heartbeat::kTransitions);
       break;
     }

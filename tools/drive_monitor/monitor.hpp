@@ -95,6 +95,7 @@ struct HeartbeatStatus {
   int64_t controller = 0;
   bool can_bus_off = false;
   int64_t rejected_commands = 0;
+  int64_t limited = 0;  ///< the limit that holds the drive back (0 none)
   int64_t transitions = 0;
 };
 

@@ -45,8 +45,9 @@ void add_heartbeat(std::string& out, const DriveStatus& status) {
   add(out, "heartbeat",
       fmt::format("#{} ({} received), command counter {}, drive CAN bus-off {}", h.counter, h.count,
                   h.command_counter, h.can_bus_off ? "yes" : "no"));
+  add(out, "limited", enum_text(signal(MessageId::heartbeat, "limited"), h.limited));
   add(out, "commands",
-      fmt::format("{} rejected (wraps at 256), {} command frames seen", h.rejected_commands,
+      fmt::format("{} rejected (wraps at 64), {} command frames seen", h.rejected_commands,
                   status.frames.commands));
 }
 

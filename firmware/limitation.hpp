@@ -1,0 +1,82 @@
+#pragma once
+/// Whether a limit keeps the drive from its reference, and which one. Each tick the law says
+/// whether a limit cut what its speed or flux channel wanted (LawDiagnostics::limit); a limit
+/// that holds for most of a window is a limitation the user must hear of: the `limited` field of
+/// the heartbeat and of the summary. Tick context except construction.
+///
+/// The window is four time constants of the default speed loop (control/ifoc_design.hpp), so
+/// that a limit touched for a tick or two by a transient, or by the sliding-mode law's
+/// occasional step onto the voltage disk, is not reported, and a limit that holds the speed back
+/// is reported while the speed loop would still be settling. A leaky count (+1 a limited tick,
+/// -1 a free one) must reach the window to raise the flag and fall back to zero to clear it:
+/// a limit active in more than half of the ticks, for long enough.
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+
+#include "control/ifoc_design.hpp"
+#include "firmware/drive_config.hpp"
+
+namespace imd::firmware {
+
+/// What held the drive back (the heartbeat's 2-bit `limited` signal).
+enum class Limitation : uint8_t {
+  none = 0,
+  voltage = 1,  ///< the inverter's voltage: above base speed, or a low bus
+  current = 2,  ///< the current limit
+  torque = 3,   ///< the configured torque limit
+  /// The law's input left the feasible set (voltage and current disks, control/input_disk.hpp):
+  /// the drive resolves it to voltage or current. Never reported as such.
+  input = 4,
+};
+
+/// The value table's name ("none", "voltage", "current", "torque").
+constexpr const char* limitation_name(Limitation l) noexcept {
+  switch (l) {
+    case Limitation::voltage: return "voltage";
+    case Limitation::current: return "current";
+    case Limitation::torque: return "torque";
+    case Limitation::input: return "input";
+    case Limitation::none: break;
+  }
+  return "none";
+}
+
+/// Ticks of a limit held that raise `limited`: four time constants of the default speed loop
+/// at this sample period and encoder observer (about 40 ms at 10 kHz).
+inline uint32_t limited_window_ticks(const DriveConfig& config) noexcept {
+  const double bandwidth_rad_s = control::default_speed_bandwidth_rad_s(
+      control::default_current_bandwidth_rad_s(config.sample_period_s),
+      config.encoder_observer_bandwidth_rad_s);
+  return static_cast<uint32_t>(std::lround(4.0 / (bandwidth_rad_s * config.sample_period_s)));
+}
+
+class LimitedMonitor {
+ public:
+  explicit LimitedMonitor(uint32_t window_ticks) noexcept
+      : window_(std::max<uint32_t>(window_ticks, 1)) {}
+
+  /// The limit of this tick (none when nothing held the law back, or when not running).
+  void update(Limitation now) noexcept {
+    if (now != Limitation::none) {
+      level_ = std::min(level_ + 1, window_);
+      // Raised once the count is full; while raised, the latest limit is the reason.
+      if (level_ == window_ || limited_ != Limitation::none) limited_ = now;
+    } else if (level_ > 0 && --level_ == 0) {
+      limited_ = Limitation::none;
+    }
+  }
+  void reset() noexcept {
+    level_ = 0;
+    limited_ = Limitation::none;
+  }
+  /// The limitation in force, none if there is none.
+  Limitation limited() const noexcept { return limited_; }
+
+ private:
+  uint32_t window_;
+  uint32_t level_ = 0;
+  Limitation limited_ = Limitation::none;
+};
+
+}  // namespace imd::firmware
