@@ -38,6 +38,22 @@ RUNNING = 3  # the drive state's number (firmware/drive_state.hpp, the CAN proto
 LOAD_STEP_S = 1.5
 RIPPLE_BAND_HZ = (1000.0, 5000.0)
 
+
+
+def twice_base_speed():
+    """Twice the base speed of the base scenario's motor and board: where the no-load stator
+    voltage at the flux reference, i_d sqrt(Rs^2 + (w_e Ls)^2) with i_d = psi/Lm, reaches
+    0.95 v_bus/sqrt(3) (tests/hal_sim/test_field_weakening.cpp, the same rule)."""
+    doc = tomllib.loads(BASE.read_text())
+    m = tomllib.loads((BASE.parent / doc["motor_file"]).read_text())["motor"]
+    v_max = 0.95 * doc["inverter"]["v_bus_V"] / math.sqrt(3)
+    i_d = math.sqrt(doc["reference"]["flux"]["flux2_Wb2"]) / m["Lm_H"]
+    base = math.sqrt((v_max / i_d) ** 2 - m["Rs_Ohm"] ** 2) / m["Ls_H"] / m["pole_pairs"]
+    return 2 * round(base)
+
+
+TWICE_BASE_RAD_S = twice_base_speed()
+
 # name: (what it shows, changes to the base scenario: {"table.key": value})
 CASES = {
     "realistic": ("seed-000 realistic profile: sine to 100 rad/s, 1 N m square load", {}),
@@ -55,6 +71,12 @@ CASES = {
         "drive.max_accel_rad_s2": 100.0,
         "load": {"kind": "steps", "times_s": [0.0], "values_Nm": [0.3]},
         "protection.overspeed_rad_s": 600.0,
+        "simulation.duration_s": 6.0, "metrics.settle_s": 5.0}),
+    "twice_base": (f"{TWICE_BASE_RAD_S} rad/s, 2 x base speed (ramp over 3 s), no load", {
+        "reference.speed": {"kind": "steps", "times_s": [0.0], "values_rad_s": [TWICE_BASE_RAD_S]},
+        "drive.max_accel_rad_s2": TWICE_BASE_RAD_S / 3.0,
+        "load": {"kind": "steps", "times_s": [0.0], "values_Nm": [0.0]},
+        "protection.overspeed_rad_s": 1.5 * TWICE_BASE_RAD_S,
         "simulation.duration_s": 6.0, "metrics.settle_s": 5.0}),
     "rotor_hot": ("realistic profile, plant Rr = 1.5 x the controller's", {
         "plant.Rr_Ohm": 1.5}),
@@ -161,6 +183,15 @@ def band_rms(x, band_hz):
     return math.sqrt(power[(f >= band_hz[0]) & (f <= band_hz[1])].sum())
 
 
+def limited_text(summary):
+    """The run's last limitation: its reason and span, or "none"."""
+    span = summary["limited"]
+    if span is None:
+        return "none"
+    to = "end" if span["to_s"] is None else f"{span['to_s']:.2f} s"
+    return f"{span['reason']}, {span['from_s']:.2f} s to {to}"
+
+
 def analyse(summary, csv, pole_pairs, case):
     d = np.genfromtxt(csv, delimiter=",", names=True)
     after = d["t_s"] >= summary["settle_s"]
@@ -170,6 +201,9 @@ def analyse(summary, csv, pole_pairs, case):
          "saturated": summary["saturated_fraction"], "i_peak": summary["i_peak_A"],
          "i_ripple": summary["current_ripple_control_rms_A"], "v_ripple": summary["voltage_ripple_rms_V"],
          "faults": ", ".join(f["code"] for f in summary["faults"]) or "none",
+         "limited": limited_text(summary),
+         "speed": d["omega_mech_rad_s"], "ramp": d["omega_ref_cmd_rad_s"],
+         "flux2": d["flux2_Wb2"], "limited_column": d["limited"],
          "law_ns": summary["stage_ns"]["law"], "tick_ns": summary["tick_exec_ns_mean"],
          # Plotted against the drive's own reference (after its ramp) while it runs.
          "t": d["t_s"], "error": np.where(d["state"] == RUNNING,
@@ -204,8 +238,30 @@ def pil_instructions(elf, law):
     return scenario_name, float(fields["tick.exec_ns_mean"]), law_counts
 
 
+def plot_twice_base(results, path):
+    """Speed and rotor flux of each law on the step to twice the base speed; the time the
+    drive reported itself limited is shaded."""
+    fig, (speed, flux) = plt.subplots(2, 1, figsize=(10, 7), sharex=True, constrained_layout=True)
+    for i, law in enumerate(LAWS):
+        r = results["twice_base"][law]
+        line, = speed.plot(r["t"], r["speed"], lw=1.0, label=f"{law} (limited: {r['limited']})")
+        flux.plot(r["t"], r["flux2"], lw=0.8, color=line.get_color(), label=law)
+        limited = r["limited_column"] > 0
+        speed.fill_between(r["t"], i * 0.02, i * 0.02 + 0.02, where=limited, color=line.get_color(),
+                           alpha=0.6, transform=speed.get_xaxis_transform(), step="mid")
+    r = results["twice_base"][LAWS[-1]]
+    speed.plot(r["t"], r["ramp"], "k--", lw=0.8, label="reference after the ramp")
+    speed.set(ylabel="speed [rad/s]", title=CASES["twice_base"][0] + " (bars: limited)")
+    flux.set(xlabel="t [s]", ylabel="rotor flux^2 [Wb^2]")
+    speed.legend(loc="lower right", fontsize=8)
+    flux.legend(loc="upper right", fontsize=8)
+    fig.savefig(path, dpi=80)
+
+
 def plot(results, path):
-    fig, axes = plt.subplots(3, 2, figsize=(12, 10), constrained_layout=True)
+    fig, axes = plt.subplots(4, 2, figsize=(12, 13), constrained_layout=True)
+    for ax in axes.flat[len(CASES):]:
+        ax.axis("off")
     for ax, case in zip(axes.flat, CASES):
         for law in LAWS:
             r = results[case][law]
@@ -220,15 +276,16 @@ def plot(results, path):
 
 def table(results, pil):
     rows = ["| case | law | speed RMS [rad/s] | peak error [rad/s] | q ripple 1-5 kHz [A] "
-            "| current ripple [A] | voltage ripple [V] | saturated | peak current [A] | faults |",
-            "|---|---|---|---|---|---|---|---|---|---|"]
+            "| current ripple [A] | voltage ripple [V] | saturated | peak current [A] | faults "
+            "| limited (last) |",
+            "|---|---|---|---|---|---|---|---|---|---|---|"]
     for case in CASES:
         for law in LAWS:
             r = results[case][law]
             rows.append(f"| {case} | {law} | {r['speed_rms']:.3g} | {r['speed_max']:.3g} | "
                         f"{r['ripple']:.3g} | {r['i_ripple']:.3g} | {r['v_ripple']:.3g} | "
                         f"{r['saturated']:.3f} | {r['i_peak']:.2f} | "
-                        f"{r['faults']} |")
+                        f"{r['faults']} | {r['limited']} |")
     rows += ["", "Current and voltage ripple: the summary's control-rate ripple per phase, "
              "f_s/4..f_s/2 (docs/control.md); the q ripple is the 1-5 kHz band of the "
              "rotor-frame q current.", "", "Load step (50 rad/s, 0 -> 2 N m): the largest speed error after the step, and "
@@ -238,7 +295,7 @@ def table(results, pil):
         r = results["load_step"][law]
         rows.append(f"| {law} | {r['dip']:.3g} | {1e3 * r['recovery_s']:.1f} |")
     rows += ["", "Tick cost. Host: mean time of the law stage and of the tick (sense to actuate) "
-             "in double, the median over the six cases (a shared machine: for comparison only). "
+             "in double, the median over the cases (a shared machine: for comparison only). "
              "Cortex-M4F: mean instructions on the PIL run (QEMU mps2-an386, float)"
              + ("." if pil else ": not run (--no-pil)."), "",
              "| law | host law [ns] | host tick [ns] | M4F scenario | M4F tick | M4F law stage |",
@@ -276,9 +333,13 @@ def main():
     image = args.results.parent / "img" / "compare_controllers.png"
     image.parent.mkdir(exist_ok=True)
     plot(results, image)
+    twice_base = image.parent / "twice_base_speed.png"
+    plot_twice_base(results, twice_base)
     section = (f"{BEGIN}\n`tools/compare_controllers.sh` writes this section and "
                f"[the plot](img/{image.name}).\n\n{table(results, pil)}\n"
-               f"![speed error of each law in each case](img/{image.name})\n{END}")
+               f"![speed error of each law in each case](img/{image.name})\n\n"
+               f"The step to twice the base speed, [speed and flux](img/{twice_base.name}):\n\n"
+               f"![speed and flux at twice the base speed](img/{twice_base.name})\n{END}")
     text = args.results.read_text()
     if BEGIN in text and END in text:
         text = text[:text.index(BEGIN)] + section + text[text.index(END) + len(END):]
