@@ -34,7 +34,8 @@ class IolLaw final : public ControlLaw<T> {
 
   LawOutput<T> step(const LawInput<T>& in, LawDiagnostics<T>& report) noexcept override {
     const IolTickResult<T> r =
-        stage_.tick(in.e.x.flux_r_AB_Wb, in.e.x.omega_mech_rad_s, in.ahead, in.v_max_V);
+        stage_.tick(in.e.x.flux_r_AB_Wb, in.e.x.omega_mech_rad_s, in.ahead, in.v_max_V,
+                    in.e.x.i_s_AB_A);
     LawOutput<T> out;
     out.ok = r.status == control::IolStatus::ok;
     out.i_cmd_AB_A = r.i_cmd_AB_A;

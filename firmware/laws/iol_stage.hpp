@@ -50,6 +50,7 @@ class IolStage {
         ticks_per_period_(
             static_cast<int>(std::lround(config.iol_period_s / config.sample_period_s))),
         lead_ticks_(config.current_response_ticks + config.pwm_latency_ticks),
+        current_imposed_(config.current_response_ticks == 0),
         outer_speed_loop_(config.outer_speed_loop),
         outer_flux_loop_(config.outer_flux_loop),
         sigma_H_(T(motor.Ls_H - motor.Lm_H * motor.Lm_H / motor.Lr_H)),
@@ -70,10 +71,12 @@ class IolStage {
     torque_held_back_ = false;
   }
 
-  /// One tick while running. `flux_r_AB_Wb` and `omega` are the estimates at this tick;
-  /// `ref_next` is the reference for the next T0 boundary.
+  /// One tick while running. `flux_r_AB_Wb`, `omega` and `i_est_AB_A` are the estimates at
+  /// this tick; `ref_next` is the reference for the next T0 boundary; `v_max_V` the stator
+  /// voltage the modulation reaches (+inf without a limit).
   IolTickResult<T> tick(const control::Vec2<T>& flux_r_AB_Wb, T omega_mech_rad_s,
-                        const Reference<T>& ref_next, T v_max_V) noexcept {
+                        const Reference<T>& ref_next, T v_max_V,
+                        const control::Vec2<T>& i_est_AB_A) noexcept {
     IolTickResult<T> r;
     if (ticks_++ % ticks_per_period_ == 0) {
       // A boundary: the current computed one period ago, u(k-1) = i(t_k), is imposed now and
@@ -90,7 +93,11 @@ class IolStage {
     r.i_cmd_AB_A = (!r.boundary && ticks_per_period_ - phase <= lead_ticks_) ? i_next_ : i_held_;
     if (!r.boundary) return r;
     // The stator flux just after the current stepped to the held value (15).
-    const control::Vec2<T> flux_s = sigma_H_ * i_held_ + Lm_over_Lr_ * flux_r_AB_Wb;
+    // The current that flows now: the one held, where the power stage imposes it; the
+    // estimate, where a current loop makes it and may fall short (on the voltage limit, a
+    // command of tens of amperes in a fast transient does not arrive).
+    const control::Vec2<T>& i_now = current_imposed_ ? i_held_ : i_est_AB_A;
+    const control::Vec2<T> flux_s = sigma_H_ * i_now + Lm_over_Lr_ * flux_r_AB_Wb;
     r.flux2_s_Wb2 = flux_s.squaredNorm();
     r.y2 = law_.y2(flux_s, flux_s_before_);
     flux_s_before_ = flux_s;
@@ -149,6 +156,7 @@ class IolStage {
   control::SpeedPi<T> speed_pi_;
   int ticks_per_period_;
   int lead_ticks_;  ///< ticks before a boundary at which u(k) is commanded
+  bool current_imposed_;  ///< an ideal current source: the held current is the current
   bool outer_speed_loop_, outer_flux_loop_;
   T sigma_H_, Lm_over_Lr_;
   T p_;

@@ -123,14 +123,6 @@ class TwiceBaseSpeed : public testing::TestWithParam<std::tuple<int, std::string
 TEST_P(TwiceBaseSpeed, ReachesItOrSaysWhichLimitHoldsIt) {
   const Case& c = kCases[std::get<0>(GetParam())];
   const std::string& law = std::get<1>(GetParam());
-  if (law == "iol" && std::get<0>(GetParam()) == 0) {
-    // Known and open (docs/results.md, "Twice the base speed"): on the paper-000 motor
-    // (Rs = 14 Ohm, high slip) this ramp saturates the deadbeat current loop from 150 rad/s on;
-    // the law, which computes the stator flux from the current it commanded, then lets the
-    // flux oscillate, and in this run trips singular_control near 380 rad/s. A safe stop, but
-    // not what this test demands.
-    GTEST_SKIP() << "iol on the paper-000 motor: singular_control under a voltage-limited ramp";
-  }
   const Outcome r = run(c, law);
   const Summary& s = r.summary;
   const bool limited_at_end = s.limited && std::isnan(s.limited->to_s);
