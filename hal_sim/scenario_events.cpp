@@ -52,8 +52,9 @@ FaultInjection read_fault(Reader& r, const std::string& base, const toml::table&
 
   for (const auto& [name, node] : table) {
     if (name == "at_s" || name == "kind") continue;
+    const std::string_view key_name = name.str();  // clang 14 cannot capture a structured binding
     const auto known = std::find_if(kFaultKeys.begin(), kFaultKeys.end(),
-                                    [&](const FaultKey& k) { return k.name == name.str(); });
+                                    [&](const FaultKey& k) { return k.name == key_name; });
     if (known == kFaultKeys.end()) r.unknown_key(key(name.str()));
     if (known->kind != fault.kind && known->other_kind != fault.kind) {
       r.fail(key(name.str()), fmt::format("= {}: not a key of kind \"{}\" (only of {})",

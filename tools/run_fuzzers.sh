@@ -1,7 +1,7 @@
 #!/bin/sh
 # run_fuzzers.sh [SECONDS]: builds the libFuzzer harnesses (fuzz preset, clang, ASan + UBSan)
 # and runs each for SECONDS (default 60) on its corpus under build-fuzz/corpus/, seeded from
-# tests/data/can. Prints per harness the executions, the crashes found and the corpus size;
+# the shipped CAN logs, motor files and scenarios. Prints per harness the executions, the crashes found and the corpus size;
 # exits non-zero if any harness crashed (the reproducer is under build-fuzz/artifacts/).
 set -eu
 duration_s=${1:-60}
@@ -20,13 +20,18 @@ cmake --build --preset fuzz
 build="$root/build-fuzz"
 status=0
 summary=""
-for harness in fuzz_command_decoder fuzz_candump_parser; do
+for harness in fuzz_command_decoder fuzz_candump_parser fuzz_motor_record fuzz_motor_file \
+    fuzz_scenario; do
   corpus="$build/corpus/$harness"
   artifacts="$build/artifacts/$harness"
   log="$build/$harness.log"
   mkdir -p "$corpus" "$artifacts"
   seeds=""
-  if [ "$harness" = fuzz_candump_parser ]; then seeds="$root/tests/data/can"; fi
+  case "$harness" in
+    fuzz_candump_parser) seeds="$root/tests/data/can" ;;
+    fuzz_motor_file) seeds="$root/tests/data/motors $root/hal_sim/motors" ;;
+    fuzz_scenario) seeds="$root/hal_sim/scenarios $root/tests/data/scenarios" ;;
+  esac
   before=$(find "$artifacts" -type f | wc -l)
   echo "run_fuzzers: $harness for ${duration_s} s (log: $log)"
   set +e
