@@ -18,6 +18,10 @@
 
 namespace imd::control {
 
+/// Share of the voltage disk the steady state may use above base speed, the same for every
+/// law; the rest is left to the transients of the current (or flux) control.
+inline constexpr double kFieldWeakeningVoltageShare = 0.9;
+
 template <typename T>
 struct FieldWeakeningMotor {
   T Rs_Ohm, Ls_H, sigma_H, Lm_H;

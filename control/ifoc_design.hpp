@@ -14,6 +14,7 @@
 ///   w_s = min(w_c / 10, w_obs / 4): a decade below the current loop (the inner loop looks like
 ///   unity to it), and a factor 4 below the speed feedback's bandwidth (14 degrees of phase).
 /// Construction only (double arithmetic).
+#include "control/field_weakening.hpp"
 #include "control/motor_parameters.hpp"
 #include "control/speed_pi.hpp"
 
@@ -27,8 +28,8 @@ struct IfocSpec {
   double torque_limit_Nm = 240.0;
   double current_limit_A = 1e300;  ///< |i| the law plans for (the other laws' margin applied)
   /// Share of the voltage disk the steady state may use in field weakening; the rest is left
-  /// to the current loops' transients.
-  double field_weakening_voltage_share = 0.9;
+  /// to the current loops' transients (control/field_weakening.hpp).
+  double field_weakening_voltage_share = kFieldWeakeningVoltageShare;
   double min_flux_Wb = 0.03;  ///< floor of the flux the slip and the torque divide by
   int latency_ticks = 1;      ///< the angle is advanced to the period the voltage acts on
 };
@@ -51,7 +52,7 @@ struct IfocGains {
   int pole_pairs = 1;
   double J_kgm2 = 0.0, friction_Nms = 0.0;
   double torque_limit_Nm = 0.0, current_limit_A = 0.0;
-  double field_weakening_voltage_share = 0.9;
+  double field_weakening_voltage_share = kFieldWeakeningVoltageShare;
   double min_flux_Wb = 0.03;
   int latency_ticks = 1;
 };

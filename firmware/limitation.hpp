@@ -9,7 +9,8 @@
 /// occasional step onto the voltage disk, is not reported, and a limit that holds the speed back
 /// is reported while the speed loop would still be settling. A leaky count (+1 a limited tick,
 /// -1 a free one) must reach the window to raise the flag and fall back to zero to clear it:
-/// a limit active in more than half of the ticks, for long enough.
+/// a limit active in more than half of the ticks, for long enough. The reason is the limit
+/// that dominated the recent ticks.
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -54,14 +55,20 @@ inline uint32_t limited_window_ticks(const DriveConfig& config) noexcept {
 class LimitedMonitor {
  public:
   explicit LimitedMonitor(uint32_t window_ticks) noexcept
-      : window_(std::max<uint32_t>(window_ticks, 1)) {}
+      : window_(std::max<uint32_t>(window_ticks, 1)), rate_(1.0f / float(window_)) {}
 
   /// The limit of this tick (none when nothing held the law back, or when not running).
   void update(Limitation now) noexcept {
+    // Each reason's share of the recent ticks (a first-order average over the window): the
+    // reason reported is the one that dominates, so that ticks alternating between the
+    // voltage and the current disk do not flip it.
+    for (int r = 0; r < kReasons; ++r) {
+      const float hit = int(now) == r + 1 ? 1.0f : 0.0f;
+      share_[r] += (hit - share_[r]) * rate_;
+    }
     if (now != Limitation::none) {
       level_ = std::min(level_ + 1, window_);
-      // Raised once the count is full; while raised, the latest limit is the reason.
-      if (level_ == window_ || limited_ != Limitation::none) limited_ = now;
+      if (level_ == window_ || limited_ != Limitation::none) limited_ = dominant();
     } else if (level_ > 0 && --level_ == 0) {
       limited_ = Limitation::none;
     }
@@ -69,14 +76,27 @@ class LimitedMonitor {
   void reset() noexcept {
     level_ = 0;
     limited_ = Limitation::none;
+    for (float& share : share_) share = 0.0f;
   }
-  /// The limitation in force, none if there is none.
+  /// The limitation in force, none if there is none. It clears a window after the last
+  /// limited tick, and until then keeps its reason.
   Limitation limited() const noexcept { return limited_; }
 
  private:
+  static constexpr int kReasons = 3;  ///< voltage, current, torque
+  Limitation dominant() const noexcept {
+    int best = 0;
+    for (int r = 1; r < kReasons; ++r) {
+      if (share_[r] > share_[best]) best = r;
+    }
+    return Limitation(best + 1);
+  }
+
   uint32_t window_;
+  float rate_;  ///< 1 / window
   uint32_t level_ = 0;
   Limitation limited_ = Limitation::none;
+  float share_[kReasons] = {0.0f, 0.0f, 0.0f};
 };
 
 }  // namespace imd::firmware

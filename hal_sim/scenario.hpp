@@ -41,8 +41,10 @@ struct ProtectionSettings {
   std::optional<double> bus_min_V;        ///< below: undervoltage
   std::optional<double> bus_max_V;        ///< above: overvoltage (> bus_min_V)
   std::optional<double> overspeed_rad_s;  ///< |estimated speed| trip
-  /// Encoder loss: counts the motion model predicts within one window without a count seen.
+  /// Encoder loss: count edges the rotor must have crossed, whatever the load, without a count.
   std::optional<double> encoder_missing_counts;
+  /// Encoder: the largest load allowed for, a share of the torque at the current limit, (0, 1).
+  std::optional<double> encoder_max_load_share;
   std::optional<int> adc_stuck_ticks;  ///< ticks of identical phase codes that mean stuck, >= 2
   /// Phase loss: a phase's mean |i| below this share of the largest phase's, in (0, 1) ...
   std::optional<double> phase_loss_ratio;

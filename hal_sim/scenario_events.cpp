@@ -194,6 +194,11 @@ void read_protection(Reader& r, Scenario& s) {
   }
   p.overspeed_rad_s = r.optional_positive("protection.overspeed_rad_s");
   p.encoder_missing_counts = r.optional_positive("protection.encoder_missing_counts");
+  p.encoder_max_load_share = r.optional_positive("protection.encoder_max_load_share");
+  if (p.encoder_max_load_share && !(*p.encoder_max_load_share < 1.0)) {
+    r.fail("protection.encoder_max_load_share",
+           fmt::format("= {}: must be in (0, 1)", *p.encoder_max_load_share));
+  }
   constexpr int64_t kIntMax = std::numeric_limits<int>::max();
   if (const auto ticks = r.optional_integer("protection.adc_stuck_ticks", 2, kIntMax)) {
     p.adc_stuck_ticks = static_cast<int>(*ticks);

@@ -3,6 +3,7 @@
 /// squared rotor flux, on the state predicted over the latency, within the feasible inputs.
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "control/dsmc.hpp"
 #include "control/field_weakening.hpp"
@@ -24,7 +25,8 @@ class DsmcLaw final : public ControlLaw<T> {
                   T(c.motor.Ls_H - c.motor.Lm_H * c.motor.Lm_H / c.motor.Lr_H), T(c.motor.Lm_H)},
         p_(T(c.motor.pole_pairs)),
         slip_per_A_(T(c.motor.Rr_Ohm / c.motor.Lr_H * c.motor.Lm_H)),
-        min_flux2_(T(c.config.min_flux2_Wb2)) {}
+        min_flux2_(T(c.config.min_flux2_Wb2)),
+        flux2_rise_per_tick_(T(2.0 * c.config.sample_period_s * c.motor.Rr_Ohm / c.motor.Lr_H)) {}
 
   /// The law's settings: the paper's speed channel with its reaching pole, or the torque
   /// channel with the pole of its speed bandwidth (docs/control.md). Construction only.
@@ -66,8 +68,13 @@ class DsmcLaw final : public ControlLaw<T> {
     return control::default_current_bandwidth_rad_s(config.sample_period_s);
   }
 
-  /// The law keeps no state from tick to tick: nothing to take over from the one it replaces.
-  void continue_from(const DsmcLaw& old) noexcept { (void)old; }
+  /// Takes over the field-weakening limit of the law it replaces.
+  void continue_from(const DsmcLaw& old) noexcept { flux2_limit_Wb2_ = old.flux2_limit_Wb2_; }
+  void start(const control::RotorFrameState<T>& x, const control::Vec2<T>& i_AB_A) noexcept override {
+    (void)x;
+    (void)i_AB_A;
+    flux2_limit_Wb2_ = std::numeric_limits<T>::infinity();
+  }
 
   ControlledFlux controlled_flux() const noexcept override { return ControlledFlux::rotor; }
   bool follows_speed() const noexcept override { return true; }
@@ -82,11 +89,17 @@ class DsmcLaw final : public ControlLaw<T> {
     const T i_q = (flux_AB.x() * in.e.x_input.i_s_AB_A.y() -
                    flux_AB.y() * in.e.x_input.i_s_AB_A.x()) / flux_Wb;
     const T omega_e = p_ * in.e.x_input.omega_mech_rad_s + slip_per_A_ * i_q / flux_Wb;
-    const T v_fw = T(0.9) * in.v_max_V;
+    const T v_fw = T(control::kFieldWeakeningVoltageShare) * in.v_max_V;
     const T flux_limit =
         std::max(control::voltage_limited_flux_Wb(fw_motor_, omega_e, i_q, v_fw),
                  control::max_torque_per_volt_flux_Wb(fw_motor_, omega_e, v_fw));
-    const T flux2_limit = std::max(flux_limit * flux_limit, min_flux2_);
+    // The limit falls at once, and rises no faster than the rotor flux can follow, twice the
+    // rotor's rate: at the end of a ramp the torque current drops and the limit jumps up, and
+    // a flux reference that jumped with it would take the whole voltage for the flux and turn
+    // the torque round (the flux channel has priority on the disk).
+    const T allowed = std::max(flux2_limit_Wb2_, min_flux2_) * (T(1) + flux2_rise_per_tick_);
+    flux2_limit_Wb2_ = std::min(std::max(flux_limit * flux_limit, min_flux2_), allowed);
+    const T flux2_limit = flux2_limit_Wb2_;
     report.flux_ref_Wb = std::sqrt(std::min(in.next.flux2_Wb2, flux2_limit));
 
     control::DsmcInput<T> d;
@@ -118,6 +131,8 @@ class DsmcLaw final : public ControlLaw<T> {
   control::Dsmc<T> dsmc_;
   control::FieldWeakeningMotor<T> fw_motor_;
   T p_, slip_per_A_, min_flux2_;
+  T flux2_rise_per_tick_;  ///< 2 delta / tau_r
+  T flux2_limit_Wb2_ = std::numeric_limits<T>::infinity();  ///< field weakening's, last tick
 };
 
 }  // namespace imd::firmware

@@ -65,7 +65,9 @@ class IfocLaw final : public ControlLaw<T> {
     report.flux_ref_Wb = out.flux_ref_Wb;
     report.slip_rad_s = ifoc_.flux_model().slip_rad_s();
     report.voltage_limited = out.voltage_limited;
-    report.limit = out.voltage_limited  ? Limitation::voltage
+    // Its disk is the feasible one, inside both the voltage and the current limit: the drive
+    // names the one that binds (InputLimits::binding).
+    report.limit = out.voltage_limited  ? Limitation::input
                    : out.torque_limited ? Limitation::current
                    : out.torque_clamped ? Limitation::torque
                                         : Limitation::none;

@@ -11,6 +11,7 @@
 #include <limits>
 
 #include "control/current_fed_model.hpp"
+#include "control/field_weakening.hpp"
 #include "control/flux_outer_loop.hpp"
 #include "control/frames.hpp"
 #include "control/iol.hpp"
@@ -120,7 +121,7 @@ class IolStage {
   }
 
   /// Field weakening by the 1/w law: the squared stator flux whose back-EMF p |w| |phi_s| fits
-  /// 0.9 v_max (the DSMC's and the IFOC's tenth left to the transients). With Rs neglected this
+  /// the share of v_max every law uses (control/field_weakening.hpp). With Rs neglected this
   /// is also the flux of the most torque the voltage allows: the pull-out torque grows as
   /// |phi_s|^2. Neither the Rs drop nor the slip enters. The law's held current, from which
   /// both would come, is a command that the current loop may not reach (tens of amperes in a
@@ -133,7 +134,7 @@ class IolStage {
     if (!(v_max_V < std::numeric_limits<T>::infinity()) || !(omega_e > T(0))) {
       return std::numeric_limits<T>::infinity();
     }
-    const T flux_s = T(0.9) * v_max_V / omega_e;
+    const T flux_s = T(control::kFieldWeakeningVoltageShare) * v_max_V / omega_e;
     return flux_s * flux_s;
   }
 

@@ -1,15 +1,26 @@
 #pragma once
 /// Encoder plausibility. Two failures are caught:
 ///  - a jump: more counts in one tick than 1.5 x the overspeed limit could produce;
-///  - silence: no count while the motion model says the rotor has turned by more than it can
-///    have turned unseen. The model starts from the estimated speed and load at the last count
-///    and integrates the electromagnetic torque the drive applies, so a rotor that is braked to
-///    a stop, or held at standstill, predicts no motion. Its start is only as good as those
-///    estimates: the encoder's quantization alone leaves them off by up to dw and dL (the
-///    observer's bounds, control/encoder_observer.hpp), which move the model by dw t +
-///    dL t^2 / (2 J) after t of silence. The allowance is that plus `missing_counts`. It is
-///    re-anchored every `window_s`: a drift of the held torque then counts for one window only.
-/// Tick context, no heap.
+///  - silence: no count while the rotor must have turned by more than it can turn unseen,
+///    whatever the load does.
+///
+/// The silence test does not trust the load estimate: a load step makes it wrong for a while,
+/// and a check built on it tripped on healthy encoders. It bounds the rotor's motion instead.
+/// From the last count on, the speed lies between two bounds that the worst loads drive:
+///   J dw_lo/dt = T - L_max - c w_lo,   J dw_hi/dt = T + L_max - c w_hi,
+/// with T the electromagnetic torque the drive applies, c the friction and L_max the largest
+/// load the check allows for (either sign). They start from the speed estimate at the count,
+/// widened by its quantization error and by the lag a load step of L_max leaves in the encoder
+/// observer (L_max / (J w_obs)). The travel since the count lies between their integrals. A
+/// healthy encoder counts once the rotor has crossed `missing_counts` count edges (one for the
+/// unknown place within the count at the start, one to spare): if the lower travel bound
+/// exceeds that, or the upper one falls below minus that, with no count seen, the encoder has
+/// failed.
+///
+/// So no load within +-L_max trips the check; a failed encoder is found once the rotor must
+/// have moved: at speed within a tick or two, at low speed once the drive's torque exceeds
+/// L_max (a speed loop on a frozen encoder drives it to its limit). Tick context, no heap.
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <numbers>
@@ -33,81 +44,76 @@ class EncoderCheck {
     double J_kgm2 = 0.01;
     double friction_Nms = 0.0;
     double missing_counts = 2.0;
-    double window_s = 0.02;
     double overspeed_rad_s = 400.0;
-    /// The estimates' errors from quantization (control/encoder_quantization_bounds).
+    /// The speed estimate's error from quantization (control/encoder_quantization_bounds).
     double speed_error_rad_s = 0.0;
-    double load_error_Nm = 0.0;
+    double observer_bandwidth_rad_s = 400.0;  ///< the encoder observer's
   };
 
   explicit EncoderCheck(const Config& c) noexcept
       : period_s_(T(c.period_s)),
-        per_J_(T(1.0 / c.J_kgm2)),
+        period_per_J_(T(c.period_s / c.J_kgm2)),
         friction_(T(c.friction_Nms)),
         missing_rad_(T(c.missing_counts * 2.0 * std::numbers::pi / c.counts_per_rev)),
-        speed_error_T_(T(c.speed_error_rad_s * c.period_s)),
-        load_error_T2_per_2J_(T(c.load_error_Nm * c.period_s * c.period_s / (2.0 * c.J_kgm2))),
-        window_ticks_(static_cast<uint32_t>(std::ceil(c.window_s / c.period_s))),
-        max_jump_counts_(
-            static_cast<int32_t>(std::ceil(1.5 * c.overspeed_rad_s * c.period_s * c.counts_per_rev /
-                                           (2.0 * std::numbers::pi))) +
-            2) {
+        speed_error_rad_s_(T(c.speed_error_rad_s)),
+        lag_per_Nm_(T(1.0 / (c.J_kgm2 * c.observer_bandwidth_rad_s))),
+        max_jump_counts_(max_jump(c.overspeed_rad_s, c.period_s, c.counts_per_rev)) {
     reset();
   }
 
   /// Forget the history (after the encoder was (re)started or a fault was cleared).
   void reset() noexcept {
-    silent_ticks_ = window_ticks_;
-    travel_rad_ = omega_rad_s_ = T(0);
+    anchored_ = false;
+    omega_lo_ = omega_hi_ = travel_lo_ = travel_hi_ = T(0);
   }
 
-  /// One tick: the counts seen over the last period, and the drive's estimates now.
-  /// `torque_Nm` is the electromagnetic torque over the coming period. With the PWM off
-  /// (`driving` false) the load is unknown (a braked or held rotor), so only jumps are judged
-  /// and the model restarts when the drive does. True if the encoder has failed.
-  bool failed(int32_t delta_counts, T omega_est_rad_s, T load_est_Nm, T torque_Nm,
+  /// One tick: the counts seen over the last period, the speed estimate now, the
+  /// electromagnetic torque over the coming period and the largest load to allow for. With
+  /// the PWM off (`driving` false) nothing bounds the load (a braked or held rotor), so only
+  /// jumps are judged and the bounds restart when the drive does. True if the encoder failed.
+  bool failed(int32_t delta_counts, T omega_est_rad_s, T torque_Nm, T max_load_Nm,
               bool driving = true) noexcept {
     if (delta_counts > max_jump_counts_ || delta_counts < -max_jump_counts_) return true;
     if (!driving) {
       reset();
       return false;
     }
-    // The model predicted `travel_rad_` over the silence so far (silent_ticks_ periods).
-    if (delta_counts == 0 && std::abs(travel_rad_) > allowance_rad(silent_ticks_)) return true;
-    if (delta_counts != 0 || silent_ticks_ >= window_ticks_) {  // anchor to the estimate
-      omega_rad_s_ = omega_est_rad_s;
-      load_Nm_ = load_est_Nm;
-      travel_rad_ = T(0);
-      silent_ticks_ = 0;
+    if (delta_counts != 0 || !anchored_) {  // a count: the rotor is at a count edge now
+      const T margin = speed_error_rad_s_ + max_load_Nm * lag_per_Nm_;
+      omega_lo_ = omega_est_rad_s - margin;
+      omega_hi_ = omega_est_rad_s + margin;
+      travel_lo_ = travel_hi_ = T(0);
+      anchored_ = true;
+    } else if (travel_lo_ > missing_rad_ || travel_hi_ < -missing_rad_) {
+      return true;
     }
-    ++silent_ticks_;
-    travel_rad_ += omega_rad_s_ * period_s_;
-    omega_rad_s_ += (torque_Nm - load_Nm_ - friction_ * omega_rad_s_) * per_J_ * period_s_;
+    // Over the coming period; the travel takes the less favourable end of each bound.
+    const T lo = omega_lo_ + (torque_Nm - max_load_Nm - friction_ * omega_lo_) * period_per_J_;
+    const T hi = omega_hi_ + (torque_Nm + max_load_Nm - friction_ * omega_hi_) * period_per_J_;
+    travel_lo_ += std::min(omega_lo_, lo) * period_s_;
+    travel_hi_ += std::max(omega_hi_, hi) * period_s_;
+    omega_lo_ = lo;
+    omega_hi_ = hi;
     return false;
   }
 
   int32_t max_jump_counts() const noexcept { return max_jump_counts_; }
-  /// The travel the model may show after this many periods of silence without a trip.
-  T allowance_rad(uint32_t ticks) const noexcept {
-    const T n = T(ticks);
-    return missing_rad_ + speed_error_T_ * n + load_error_T2_per_2J_ * n * n;
-  }
 
   /// Takes over the state of the object this one replaces (the same motor but for its
   /// rotor resistance): the tick changes coefficients and keeps state (docs/robustness.md).
   void continue_from(const EncoderCheck& old) noexcept {
-    silent_ticks_ = old.silent_ticks_;
-    omega_rad_s_ = old.omega_rad_s_;
-    load_Nm_ = old.load_Nm_;
-    travel_rad_ = old.travel_rad_;
+    anchored_ = old.anchored_;
+    omega_lo_ = old.omega_lo_;
+    omega_hi_ = old.omega_hi_;
+    travel_lo_ = old.travel_lo_;
+    travel_hi_ = old.travel_hi_;
   }
 
  private:
-  T period_s_, per_J_, friction_, missing_rad_, speed_error_T_, load_error_T2_per_2J_;
-  uint32_t window_ticks_;
+  T period_s_, period_per_J_, friction_, missing_rad_, speed_error_rad_s_, lag_per_Nm_;
   int32_t max_jump_counts_;
-  uint32_t silent_ticks_ = 0;
-  T omega_rad_s_ = T(0), load_Nm_ = T(0), travel_rad_ = T(0);
+  bool anchored_ = false;
+  T omega_lo_ = T(0), omega_hi_ = T(0), travel_lo_ = T(0), travel_hi_ = T(0);
 };
 
 }  // namespace imd::firmware

@@ -35,10 +35,9 @@ typename EncoderCheck<T>::Config encoder_config(const control::MotorParameters& 
           motor.J_kgm2,
           motor.friction_Nms,
           config.protection.encoder_missing_counts,
-          config.protection.encoder_window_s,
           config.protection.overspeed_rad_s,
           q.omega_rad_s,
-          q.load_Nm};
+          config.encoder_observer_bandwidth_rad_s};
 }
 
 }  // namespace
@@ -49,6 +48,10 @@ MotorChecks<T>::MotorChecks(const control::MotorParameters& motor,
                             double counts_per_rev, double adc_A_per_code) noexcept
     : pole_pairs(T(motor.pole_pairs)),
       torque_per_AWb(T(control::kClarkeTorqueFactor * motor.pole_pairs * motor.Lm_H / motor.Lr_H)),
+      max_load_share(T(config.protection.encoder_max_load_share)),
+      torque_limit_Nm(T(config.torque_limit_Nm)),
+      current_limit_A(T(config.current_margin * config.i_max_A)),
+      per_Lm_H(T(1.0 / motor.Lm_H)),
       encoder(encoder_config<T>(motor, c, config, counts_per_rev)),
       adc_stuck(config.protection.adc_stuck_ticks, config.sample_period_s,
                 control::derive_voltage_fed(motor).sigma_H, adc_A_per_code) {}
@@ -128,8 +131,9 @@ inline void Protection<T>::check_sensed(const Measurement<T>& m, const Estimate<
   const bool driving = modulating && !trip.any();  // a fault has turned the PWM off
   const T torque_Nm =
       driving ? motor->torque_per_AWb * control::dot_J<T>(e.x.i_s_AB_A, e.x.flux_r_AB_Wb) : T(0);
-  if (config_.check_encoder && motor->encoder.failed(m.encoder_delta_counts, e.x.omega_mech_rad_s,
-                                                     e.load_Nm, torque_Nm, driving)) {
+  if (config_.check_encoder &&
+      motor->encoder.failed(m.encoder_delta_counts, e.x.omega_mech_rad_s, torque_Nm,
+                            motor->max_load_Nm(e.x.flux_r_AB_Wb.norm()), driving)) {
     trip.add(FaultCode::encoder);
   }
 }

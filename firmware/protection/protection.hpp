@@ -12,6 +12,8 @@
 ///      non-finite output.
 /// The tick's execution time is judged at its end (over_budget). Tick context except
 /// construction.
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
 
 #include "control/motor_parameters.hpp"
@@ -58,7 +60,19 @@ struct MotorChecks {
     adc_stuck.continue_from(old.adc_stuck);
   }
 
+  /// The encoder check's load bound: max_load_share of the torque at the current limit with
+  /// this rotor flux (the flux current |psi|/Lm first, the rest torque current), within the
+  /// torque limit. Tick context.
+  T max_load_Nm(T flux_Wb) const noexcept {
+    const T i_d = flux_Wb * per_Lm_H;
+    const T i_q2 = current_limit_A * current_limit_A - i_d * i_d;
+    const T torque =
+        i_q2 > T(0) && flux_Wb > T(0) ? torque_per_AWb * flux_Wb * std::sqrt(i_q2) : T(0);
+    return max_load_share * std::min(torque, torque_limit_Nm);
+  }
+
   T pole_pairs, torque_per_AWb;
+  T max_load_share, torque_limit_Nm, current_limit_A, per_Lm_H;
   EncoderCheck<T> encoder;
   AdcStuckCheck<T> adc_stuck;
 };

@@ -16,13 +16,16 @@ struct ProtectionConfig {
   double bus_min_V = 20.0;         ///< below: undervoltage while enabled (also a NaN reading)
   double bus_max_V = 450.0;        ///< above: overvoltage, in every state
   double overspeed_rad_s = 400.0;  ///< |estimated mechanical speed| above: overspeed
-  /// Encoder: counts the motion model may predict without a count being seen, beyond what the
-  /// estimates' quantization errors allow (docs/safety.md): one for the count at the anchor,
-  /// one to spare.
+  /// Encoder: count edges the rotor must have crossed, whatever the load, before a silence is a
+  /// failure (docs/safety.md): one for the unknown place within the count at the start, one to
+  /// spare.
   double encoder_missing_counts = 2.0;
-  /// The model is re-anchored to the estimate after this. Longer detects a loss at a lower
-  /// acceleration from rest (docs/safety.md); 20 ms detects 157 rad/s^2 on the paper motor.
-  double encoder_window_s = 0.02;
+  /// The largest load the encoder check allows for, as a share of the torque the drive can
+  /// produce at its current limit with the flux it has (and within its torque limit). No load
+  /// up to it trips the check; above it, a frozen encoder is found once the drive's torque
+  /// exceeds it. 0.75 leaves a quarter of the torque for the laws' current margins and the
+  /// torque estimate's error (docs/safety.md).
+  double encoder_max_load_share = 0.75;
   /// ADC stuck: ticks with identical phase codes while the applied voltage should have moved
   /// the current by several codes.
   int adc_stuck_ticks = 20;

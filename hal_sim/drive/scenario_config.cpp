@@ -73,6 +73,7 @@ firmware::DriveConfig drive_config(const Scenario& s) {
   p.bus_max_V = set.bus_max_V.value_or(1.3 * s.v_bus_V);
   p.overspeed_rad_s = set.overspeed_rad_s.value_or(p.overspeed_rad_s);
   p.encoder_missing_counts = set.encoder_missing_counts.value_or(p.encoder_missing_counts);
+  p.encoder_max_load_share = set.encoder_max_load_share.value_or(p.encoder_max_load_share);
   p.adc_stuck_ticks = set.adc_stuck_ticks.value_or(p.adc_stuck_ticks);
   p.phase_loss_ratio = set.phase_loss_ratio.value_or(p.phase_loss_ratio);
   p.phase_loss_min_current_A = set.phase_loss_min_current_A.value_or(p.phase_loss_min_current_A);

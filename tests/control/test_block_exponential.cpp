@@ -40,8 +40,10 @@ double worst_block_error(const BlockExponential<double>& r, const Matrix9l& e) {
                    static_cast<double>(std::abs((r.w - w) / w))});
 }
 
-// The header's bound, (1 + 4 theta) x 8 ulp of the blocks' size with theta = |X| + |g| (the
-// scaling halves until theta/2^s <= 1/4; each squaring doubles the error and adds its own).
+// The header's rounding estimate, (1 + 4 theta) x 8 ulp of the blocks' size with
+// theta = |X| + |g| (the scaling halves until theta/2^s <= 1/4; each squaring about doubles
+// the error and adds its own). An estimate, checked here over the range the drive uses and
+// beyond it to theta = 8; the header says where it stops holding.
 double tolerance(const Eigen::Matrix3d& x, double g, double ulp) {
   const double theta = x.cwiseAbs().rowwise().sum().maxCoeff() + std::abs(g);
   return (1.0 + 4.0 * theta) * 8.0 * ulp;

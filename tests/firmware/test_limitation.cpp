@@ -22,8 +22,11 @@ TEST(LimitedMonitor, RaisesAfterAWindowOfLimitedTicksAndClearsAfterAsManyFreeOne
   }
   m.update(Limitation::voltage);
   EXPECT_EQ(m.limited(), Limitation::voltage);
-  // While raised, the reason follows the latest limit.
+  // While raised, the reason is the dominant one: a tick of current does not flip it, a
+  // window of current does.
   m.update(Limitation::current);
+  EXPECT_EQ(m.limited(), Limitation::voltage);
+  for (uint32_t k = 0; k < kWindow; ++k) m.update(Limitation::current);
   EXPECT_EQ(m.limited(), Limitation::current);
   for (uint32_t k = 1; k < kWindow; ++k) {
     m.update(Limitation::none);
@@ -31,6 +34,21 @@ TEST(LimitedMonitor, RaisesAfterAWindowOfLimitedTicksAndClearsAfterAsManyFreeOne
   }
   m.update(Limitation::none);
   EXPECT_EQ(m.limited(), Limitation::none);
+}
+
+TEST(LimitedMonitor, AlternatingReasonsDoNotFlipTheReport) {
+  // Ticks alternating between the voltage and the current disk, two of voltage for one of
+  // current: raised, and voltage throughout.
+  LimitedMonitor m(kWindow);
+  int flips = 0;
+  Limitation last = Limitation::none;
+  for (int k = 0; k < 20 * int(kWindow); ++k) {
+    m.update(k % 3 == 2 ? Limitation::current : Limitation::voltage);
+    if (m.limited() != last && last != Limitation::none) ++flips;
+    last = m.limited();
+  }
+  EXPECT_EQ(m.limited(), Limitation::voltage);
+  EXPECT_EQ(flips, 0);
 }
 
 TEST(LimitedMonitor, IgnoresALimitTouchedInLessThanHalfOfTheTicks) {
@@ -82,21 +100,26 @@ TEST(InputLimitsBinding, NamesTheDiskTheInputIsNearerToLeaving) {
   x.omega_mech_rad_s = 300.0;
   const double v_bus_V = 311.0;
   const control::InputDisk<double> feasible = limits.feasible(x, v_bus_V);
-  // Walk the edge of the feasible disk: at each point one of the two shares is the larger,
-  // and binding names it. Both names must occur: here the disk is the lens's inscribed one,
-  // which touches both limits.
-  int voltage = 0, current = 0;
-  for (int i = 0; i < 360; ++i) {
-    const double a = i * 3.141592653589793 / 180.0;
-    const control::Vec2<double> v =
-        feasible.center_V + feasible.radius_V * control::Vec2<double>(std::cos(a), std::sin(a));
-    const Limitation l = limits.binding(x, v_bus_V, v);
-    ASSERT_TRUE(l == Limitation::voltage || l == Limitation::current);
-    (l == Limitation::voltage ? voltage : current) += 1;
-  }
-  std::printf("edge points: %d voltage, %d current\n", voltage, current);
-  EXPECT_GT(voltage, 0);
-  EXPECT_GT(current, 0);
+  // The feasible disk is the largest inside both limits: it touches the voltage disk on the
+  // side away from the voltage disk's centre, and the current disk on the side away from
+  // the current disk's centre. At each touching point that limit is fully used and the other
+  // is not: binding must name it.
+  InputLimitsConfig voltage_only;
+  const control::InputDisk<double> v_disk =
+      InputLimits<double>(motor, c, voltage_only).feasible(x, v_bus_V);
+  InputLimitsConfig current_only;
+  current_only.voltage_limited = false;
+  current_only.i_max_A = 6.0;
+  const control::InputDisk<double> i_disk =
+      InputLimits<double>(motor, c, current_only).feasible(x, v_bus_V);
+  ASSERT_LT(feasible.radius_V, v_disk.radius_V);  // both bound it: a lens, not one disk
+  ASSERT_LT(feasible.radius_V, i_disk.radius_V);
+  const auto touching = [&](const control::InputDisk<double>& limit) {
+    const control::Vec2<double> away = (feasible.center_V - limit.center_V).normalized();
+    return control::Vec2<double>(feasible.center_V + feasible.radius_V * away);
+  };
+  EXPECT_EQ(limits.binding(x, v_bus_V, touching(v_disk)), Limitation::voltage);
+  EXPECT_EQ(limits.binding(x, v_bus_V, touching(i_disk)), Limitation::current);
   // Without a current limit, only the voltage can bind, and the reverse.
   InputLimitsConfig no_current;
   EXPECT_EQ(InputLimits<double>(motor, c, no_current).binding(x, v_bus_V, feasible.center_V),

@@ -169,7 +169,7 @@ void write_drive(Writer& w, const DriveConfig& c) {
   w.number("drive.protection.bus_max_V", p.bus_max_V);
   w.number("drive.protection.overspeed_rad_s", p.overspeed_rad_s);
   w.number("drive.protection.encoder_missing_counts", p.encoder_missing_counts);
-  w.number("drive.protection.encoder_window_s", p.encoder_window_s);
+  w.number("drive.protection.encoder_max_load_share", p.encoder_max_load_share);
   w.integer("drive.protection.adc_stuck_ticks", p.adc_stuck_ticks);
   w.number("drive.protection.phase_loss_ratio", p.phase_loss_ratio);
   w.number("drive.protection.phase_loss_min_current_A", p.phase_loss_min_current_A);
