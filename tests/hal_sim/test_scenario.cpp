@@ -95,6 +95,8 @@ TEST(Scenario, BadInputNamesTheKey) {
       {{"protection.adc_stuck_ticks=2.5"}, "protection.adc_stuck_ticks: must be an integer"},
       {{"protection.encoder_missing_counts=0"},
        "protection.encoder_missing_counts: = 0: must be > 0"},
+      {{"protection.encoder_max_load_share=1.5"},
+       "protection.encoder_max_load_share: = 1.5: must be in (0, 1)"},
       {{"protection.phase_loss_ratio=1"}, "protection.phase_loss_ratio: = 1: must be in (0, 1)"},
       {{"protection.phase_loss_ratio=0"}, "protection.phase_loss_ratio: = 0: must be > 0"},
       {{"protection.overcurrent_A=0"}, "protection.overcurrent_A: = 0: must be > 0"},
