@@ -5,8 +5,8 @@
 /// held (the zero-order hold in the rotor frame that paper 001 assumes). The torque reference
 /// v1 comes from the reference or an outer speed PI; v2 from (21) or the outer flux loop.
 /// Tick context except the constructor.
-#include <cmath>
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <limits>
 

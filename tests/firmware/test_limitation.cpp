@@ -7,6 +7,7 @@
 #include "control/voltage_fed_model.hpp"
 #include "firmware/drive_config.hpp"
 #include "firmware/limitation.hpp"
+#include "firmware/paper_motor.hpp"
 #include "firmware/stages/input_limits.hpp"
 
 namespace imd::firmware {
@@ -80,14 +81,7 @@ TEST(LimitedMonitor, WindowIsFourTimeConstantsOfTheDefaultSpeedLoop) {
 }
 
 TEST(InputLimitsBinding, NamesTheDiskTheInputIsNearerToLeaving) {
-  control::MotorParameters motor;  // the paper-000 motor
-  motor.Rs_Ohm = 14.0;
-  motor.Ls_H = 0.4;
-  motor.Lm_H = 0.377;
-  motor.Rr_Ohm = 10.1;
-  motor.Lr_H = 0.4128;
-  motor.J_kgm2 = 0.01;
-  motor.pole_pairs = 1;
+  const control::MotorParameters motor = test::paper_motor();
   const auto c = control::discretize_voltage_fed(motor, 1e-4);
   InputLimitsConfig config;
   config.i_max_A = 6.0;

@@ -14,6 +14,7 @@
 #include "control/motor_parameters.hpp"
 #include "firmware/parameters/motor_record.hpp"
 #include "fuzz_check.hpp"
+#include "tests/firmware/paper_motor.hpp"
 
 namespace firmware = imd::firmware;
 
@@ -31,15 +32,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   if ((data[0] & 1) == 0) {
     record = decode({data + 1, size - 1});
   } else {
-    imd::control::MotorParameters m;
-    m.Rs_Ohm = 14.0;
-    m.Ls_H = 0.4;
-    m.Lm_H = 0.377;
-    m.Rr_Ohm = 10.1;
-    m.Lr_H = 0.4128;
-    m.J_kgm2 = 0.01;
-    m.pole_pairs = 1;
-    auto bytes = firmware::encode_motor_record(firmware::MotorRecord(m));
+    auto bytes = firmware::encode_motor_record(firmware::MotorRecord(imd::test::paper_motor()));
     for (size_t i = 1; i + 1 < size; i += 2) bytes[data[i] % bytes.size()] = data[i + 1];
     record = decode(bytes);
   }
