@@ -46,11 +46,12 @@ struct ProtectionSettings {
   /// Encoder: the largest load allowed for, a share of the torque at the current limit, (0, 1).
   std::optional<double> encoder_max_load_share;
   std::optional<int> adc_stuck_ticks;  ///< ticks of identical phase codes that mean stuck, >= 2
-  /// Phase loss: a phase's mean |i| below this share of the largest phase's, in (0, 1) ...
-  std::optional<double> phase_loss_ratio;
-  std::optional<double> phase_loss_min_current_A;  ///< ... while that one carries this much
-  std::optional<double> command_timeout_s;         ///< command watchdog on CAN commands
-  std::optional<double> tick_budget_us;            ///< execution-time budget of a tick
+  /// Phase loss: the inverter's worst voltage error, a share of V_bus/sqrt(3) in (0, 1), and
+  /// the current ADC's rms noise in codes.
+  std::optional<double> inverter_voltage_error_share;
+  std::optional<double> adc_noise_codes;
+  std::optional<double> command_timeout_s;  ///< command watchdog on CAN commands
+  std::optional<double> tick_budget_us;     ///< execution-time budget of a tick
   std::optional<double> stop_decel_rad_s2;  ///< deceleration of the stop on a disable command
 };
 

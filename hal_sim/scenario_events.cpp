@@ -203,12 +203,12 @@ void read_protection(Reader& r, Scenario& s) {
   if (const auto ticks = r.optional_integer("protection.adc_stuck_ticks", 2, kIntMax)) {
     p.adc_stuck_ticks = static_cast<int>(*ticks);
   }
-  p.phase_loss_ratio = r.optional_positive("protection.phase_loss_ratio");
-  if (p.phase_loss_ratio && !(*p.phase_loss_ratio < 1.0)) {
-    r.fail("protection.phase_loss_ratio",
-           fmt::format("= {}: must be in (0, 1)", *p.phase_loss_ratio));
+  p.inverter_voltage_error_share = r.optional_positive("protection.inverter_voltage_error_share");
+  if (p.inverter_voltage_error_share && !(*p.inverter_voltage_error_share < 1.0)) {
+    r.fail("protection.inverter_voltage_error_share",
+           fmt::format("= {}: must be in (0, 1)", *p.inverter_voltage_error_share));
   }
-  p.phase_loss_min_current_A = r.optional_positive("protection.phase_loss_min_current_A");
+  p.adc_noise_codes = r.optional_positive("protection.adc_noise_codes");
   p.command_timeout_s = r.optional_positive("protection.command_timeout_s");
   p.tick_budget_us = r.optional_positive("protection.tick_budget_us");
   p.stop_decel_rad_s2 = r.optional_positive("protection.stop_decel_rad_s2");

@@ -1,68 +1,81 @@
 #pragma once
-/// Phase loss: over each revolution of the flux (in the stator frame), the mean |i| of every
-/// phase is compared. A healthy motor's phase currents are equal sinusoids over a revolution;
-/// with one phase open its current stays at zero while the other two carry the whole current.
-/// Revolutions slower than `max_window_ticks` (near standstill) are not judged: a balanced DC
-/// current may legitimately be zero in one phase. Tick context.
+/// Phase loss: the current each phase should carry against the one it does. Each tick the exact
+/// model predicts the stator current from the last tick's measured current, the flux estimate
+/// and the input that acted (firmware/stages/estimate.hpp). Over a window the check sums, per
+/// phase, how much less current the phase carried than predicted: sum(|i_pred| - |i|).
+///   * On a healthy motor the measurement noise cancels in that sum (the prediction and the
+///     measurement carry alike noise), and the model's systematic error is left: at most the
+///     inverter's voltage error over the leakage inductance, du period / sigma per tick.
+///   * An open phase carries nothing while the law drives voltage into it to get the current it
+///     wants there: the sum grows each tick by the current the law asks of the phase, up to
+///     the whole voltage's worth, v_max period / sigma.
+/// So it needs no revolution of the flux: it works at standstill, at any speed and with the
+/// pulsating flux an open phase leaves. A phase the law wants no current from is harmless
+/// while open, and not seen until the law wants current there. Rules: docs/safety.md. Tick
+/// context.
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
-#include <numbers>
 
 namespace imd::firmware {
 
 template <typename T>
 class PhaseLossCheck {
  public:
-  PhaseLossCheck(double ratio, double min_current_A, uint32_t max_window_ticks) noexcept
-      : ratio_(T(ratio)), min_current_A_(T(min_current_A)), max_window_ticks_(max_window_ticks) {}
+  struct Config {
+    uint32_t window_ticks = 1;
+    /// The healthy model's largest mean shortfall per tick, per volt of DC bus (the inverter's
+    /// voltage error over the leakage inductance), and the noise of the window's mean.
+    double missing_A_per_bus_V = 0.0;
+    double noise_floor_A = 0.0;
+    /// A phase that carries less than this share of its predicted current carries none: an
+    /// open phase carries only the measurement noise, a healthy one all of it.
+    double carried_share = 0.5;
+  };
+
+  explicit PhaseLossCheck(const Config& c) noexcept
+      : window_ticks_(std::max<uint32_t>(c.window_ticks, 1)),
+        missing_A_per_bus_V_(T(c.missing_A_per_bus_V)),
+        noise_floor_A_(T(c.noise_floor_A)),
+        carried_share_(T(c.carried_share)) {}
 
   void reset() noexcept {
-    clear();
-    started_ = false;
-  }
-
-  /// Phase currents and the flux angle in the stator frame. The lost phase (0..2), or -1.
-  int lost_phase(const T (&i_abc_A)[3], T flux_angle_rad) noexcept {
-    if (!started_) {
-      last_angle_rad_ = flux_angle_rad;
-      started_ = true;
-    }
-    T step = flux_angle_rad - last_angle_rad_;  // wrapped to (-pi, pi]
-    const T two_pi = T(2 * std::numbers::pi);
-    step -= two_pi * std::round(step / two_pi);
-    swept_rad_ += step;
-    last_angle_rad_ = flux_angle_rad;
-    for (int k = 0; k < 3; ++k) sum_abs_A_[k] += std::abs(i_abc_A[k]);
-    ++ticks_;
-    if (std::abs(swept_rad_) >= two_pi) {
-      int weakest = 0, strongest = 0;
-      for (int k = 1; k < 3; ++k) {
-        if (sum_abs_A_[k] < sum_abs_A_[weakest]) weakest = k;
-        if (sum_abs_A_[k] > sum_abs_A_[strongest]) strongest = k;
-      }
-      const bool carries = sum_abs_A_[strongest] >= min_current_A_ * T(ticks_);
-      const bool lost = carries && sum_abs_A_[weakest] < ratio_ * sum_abs_A_[strongest];
-      clear();
-      if (lost) return weakest;
-    } else if (ticks_ >= max_window_ticks_) {
-      clear();
-    }
-    return -1;
-  }
-
- private:
-  void clear() noexcept {
-    std::fill(std::begin(sum_abs_A_), std::end(sum_abs_A_), T(0));
-    swept_rad_ = T(0);
+    std::fill(std::begin(predicted_A_), std::end(predicted_A_), T(0));
+    std::fill(std::begin(measured_A_), std::end(measured_A_), T(0));
     ticks_ = 0;
   }
 
-  T ratio_, min_current_A_;
-  uint32_t max_window_ticks_;
-  bool started_ = false;
-  T last_angle_rad_ = T(0), swept_rad_ = T(0);
-  T sum_abs_A_[3] = {T(0), T(0), T(0)};
+  /// Takes over the sums of the check this one replaces (the same motor but for its rotor
+  /// resistance: a window a little longer or shorter).
+  void continue_from(const PhaseLossCheck& old) noexcept {
+    std::copy(std::begin(old.predicted_A_), std::end(old.predicted_A_), predicted_A_);
+    std::copy(std::begin(old.measured_A_), std::end(old.measured_A_), measured_A_);
+    ticks_ = old.ticks_;
+  }
+
+  /// Predicted and measured phase currents, the DC bus. The lost phase (0..2), or -1.
+  int lost_phase(const T (&i_predicted_abc_A)[3], const T (&i_abc_A)[3], T v_bus_V) noexcept {
+    for (int k = 0; k < 3; ++k) {
+      predicted_A_[k] += std::abs(i_predicted_abc_A[k]);
+      measured_A_[k] += std::abs(i_abc_A[k]);
+    }
+    if (++ticks_ < window_ticks_) return -1;
+    int worst = 0;
+    for (int k = 1; k < 3; ++k) {
+      if (predicted_A_[k] - measured_A_[k] > predicted_A_[worst] - measured_A_[worst]) worst = k;
+    }
+    const T allowed_A = (missing_A_per_bus_V_ * v_bus_V + noise_floor_A_) * T(ticks_);
+    const bool lost = predicted_A_[worst] - measured_A_[worst] > allowed_A &&
+                      measured_A_[worst] < carried_share_ * predicted_A_[worst];
+    reset();
+    return lost ? worst : -1;
+  }
+
+ private:
+  uint32_t window_ticks_;
+  T missing_A_per_bus_V_, noise_floor_A_, carried_share_;
+  T predicted_A_[3] = {T(0), T(0), T(0)};
+  T measured_A_[3] = {T(0), T(0), T(0)};
   uint32_t ticks_ = 0;
 };
 

@@ -4,6 +4,7 @@
 #include <numbers>
 
 #include "control/encoder_observer.hpp"
+#include "control/svpwm.hpp"
 #include "control/voltage_fed_model.hpp"
 
 #include "firmware/duration_ticks.hpp"
@@ -40,6 +41,28 @@ typename EncoderCheck<T>::Config encoder_config(const control::MotorParameters& 
           config.encoder_observer_bandwidth_rad_s};
 }
 
+/// The phase-loss check's rules (docs/safety.md), from the motor's leakage inductance and
+/// transient time constant, the board's voltage error and ADC noise, and the sample period.
+template <typename T>
+typename PhaseLossCheck<T>::Config phase_loss_config(const control::MotorParameters& motor,
+                                                     const DriveConfig& config,
+                                                     double adc_A_per_code) {
+  const control::VoltageFedConstants k = control::derive_voltage_fed(motor);
+  const double period_s = config.sample_period_s;
+  // A window of the transient time constant sigma / (Rs + Rr Lm^2/Lr^2) = 1/gamma: the time
+  // the current takes to follow the voltage; at least 4 ticks.
+  const double window = std::max(std::ceil(1.0 / (k.gamma_per_s * period_s)), 4.0);
+  // The mean of (|i_pred| - |i|) over the window: per tick its noise is at most
+  // sqrt(2) sigma_adc; six standard deviations of the window's mean.
+  const double noise_A = config.protection.adc_noise_codes * adc_A_per_code;
+  typename PhaseLossCheck<T>::Config c;
+  c.window_ticks = static_cast<uint32_t>(window);
+  c.missing_A_per_bus_V =
+      config.protection.inverter_voltage_error_share / std::sqrt(3.0) * period_s / k.sigma_H;
+  c.noise_floor_A = 6.0 * std::sqrt(2.0) * noise_A / std::sqrt(window);
+  return c;
+}
+
 }  // namespace
 
 template <typename T>
@@ -54,7 +77,8 @@ MotorChecks<T>::MotorChecks(const control::MotorParameters& motor,
       per_Lm_H(T(1.0 / motor.Lm_H)),
       encoder(encoder_config<T>(motor, c, config, counts_per_rev)),
       adc_stuck(config.protection.adc_stuck_ticks, config.sample_period_s,
-                control::derive_voltage_fed(motor).sigma_H, adc_A_per_code) {}
+                control::derive_voltage_fed(motor).sigma_H, adc_A_per_code),
+      phase_loss(phase_loss_config<T>(motor, config, adc_A_per_code)) {}
 
 template <typename T>
 Protection<T>::Protection(const DriveConfig& config) noexcept
@@ -67,11 +91,7 @@ Protection<T>::Protection(const DriveConfig& config) noexcept
       magnetizing_timeout_ticks_(
           saturated(duration_ticks(config.magnetizing_timeout_s, config.sample_period_s))),
       command_timeout_ticks_(
-          saturated(duration_ticks(config.protection.command_timeout_s, config.sample_period_s))),
-      phase_loss_check_(config.protection.phase_loss_ratio,
-                        config.protection.phase_loss_min_current_A,
-                        static_cast<uint32_t>(duration_ticks(
-                            config.protection.phase_loss_max_window_s, config.sample_period_s))) {}
+          saturated(duration_ticks(config.protection.command_timeout_s, config.sample_period_s))) {}
 
 template <typename T>
 void Protection<T>::set_clock(uint32_t clock_Hz) noexcept {
@@ -84,10 +104,7 @@ Trip Protection<T>::check(const Measurement<T>& m, const Estimate<T>& e, const S
                           const LawOutput<T>& law, const Modulation<T>& out,
                           const control::Vec2<T>& u_last_V, MotorChecks<T>* motor) noexcept {
   Trip trip;
-  if (s.restarted) {
-    if (motor != nullptr) motor->reset();
-    phase_loss_check_.reset();
-  }
+  if (s.restarted && motor != nullptr) motor->reset();
   if (!s.enable_input && s.modulating) trip.add(FaultCode::enable_input);
   if (m.calibration == Calibration::offset_fault) {
     trip.add(FaultCode::adc_offset, m.offset_fault_phase);
@@ -95,8 +112,7 @@ Trip Protection<T>::check(const Measurement<T>& m, const Estimate<T>& e, const S
   if (!m.valid) return trip;  // nothing measured: calibrating, or offsets unknown
   check_sensed(m, e, s.modulating, motor, trip);
   if (!s.modulating || motor == nullptr || trip.any()) {
-    if (motor != nullptr) motor->adc_stuck.reset();
-    phase_loss_check_.reset();
+    if (motor != nullptr) motor->idle();
     return trip;
   }
   check_driving(m, e, s, u_last_V, *motor, trip);
@@ -146,10 +162,12 @@ inline void Protection<T>::check_driving(const Measurement<T>& m, const Estimate
   if (config_.check_adc_stuck && motor.adc_stuck.stuck(m.phase_code, u_last_V)) {
     trip.add(FaultCode::adc_stuck);
   }
-  const T flux_angle_rad =
-      motor.pole_pairs * e.x.theta_mech_rad + std::atan2(e.x.flux_r_AB_Wb.y(), e.x.flux_r_AB_Wb.x());
-  const int lost = phase_loss_check_.lost_phase(m.i_abc_A, flux_angle_rad);
-  if (lost >= 0) trip.add(FaultCode::phase_loss, uint8_t(lost));
+  if (e.current_predicted) {
+    const control::PhaseValues<T> predicted = control::inverse_clarke(e.i_predicted_alphabeta_A);
+    const T i_predicted_abc_A[3] = {predicted[0], predicted[1], predicted[2]};
+    const int lost = motor.phase_loss.lost_phase(i_predicted_abc_A, m.i_abc_A, m.v_bus_V);
+    if (lost >= 0) trip.add(FaultCode::phase_loss, uint8_t(lost));
+  }
   if (commands_over_can_ && command_timeout_ticks_ > 0 && s.watchdog_armed &&
       s.command_silence_ticks > command_timeout_ticks_) {
     trip.add(FaultCode::command_timeout);

@@ -52,12 +52,19 @@ struct MotorChecks {
               const DriveConfig& config, double counts_per_rev, double adc_A_per_code) noexcept;
   void reset() noexcept {
     encoder.reset();
+    idle();
+  }
+  /// The inverter does not drive the motor (or a fault turned it off): the checks that judge
+  /// the driven motor start afresh.
+  void idle() noexcept {
     adc_stuck.reset();
+    phase_loss.reset();
   }
   /// Takes over the checks' state from the model this one replaces (firmware/motor_model.hpp).
   void continue_from(const MotorChecks& old) noexcept {
     encoder.continue_from(old.encoder);
     adc_stuck.continue_from(old.adc_stuck);
+    phase_loss.continue_from(old.phase_loss);
   }
 
   /// The encoder check's load bound: max_load_share of the torque at the current limit with
@@ -75,6 +82,7 @@ struct MotorChecks {
   T max_load_share, torque_limit_Nm, current_limit_A, per_Lm_H;
   EncoderCheck<T> encoder;
   AdcStuckCheck<T> adc_stuck;
+  PhaseLossCheck<T> phase_loss;
 };
 
 template <typename T>
@@ -105,7 +113,6 @@ class Protection {
   T overcurrent_A_, bus_min_V_, bus_max_V_, overspeed_rad_s_;
   uint32_t magnetizing_timeout_ticks_, command_timeout_ticks_;
   uint32_t budget_counts_ = 0;
-  PhaseLossCheck<T> phase_loss_check_;
 };
 
 }  // namespace imd::firmware

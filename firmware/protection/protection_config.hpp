@@ -29,11 +29,12 @@ struct ProtectionConfig {
   /// ADC stuck: ticks with identical phase codes while the applied voltage should have moved
   /// the current by several codes.
   int adc_stuck_ticks = 20;
-  /// Phase loss: over one revolution of the flux, a phase's mean |i| below this share of the
-  /// largest phase's, while that one carries at least phase_loss_min_current_A.
-  double phase_loss_ratio = 0.3;
-  double phase_loss_min_current_A = 0.5;
-  double phase_loss_max_window_s = 1.0;  ///< a slower revolution is not judged
+  /// Phase loss (firmware/protection/phase_loss_check.hpp): the board's worst voltage error
+  /// (dead time, device drops, bus ripple) as a share of the phase voltage range V_bus/sqrt(3),
+  /// and its current ADC's rms noise in codes. The check's threshold and window follow from
+  /// them, the motor and the sample period (docs/safety.md).
+  double inverter_voltage_error_share = 0.05;
+  double adc_noise_codes = 4.0;
   /// Command watchdog while magnetizing or running on CAN commands; 0 disables it.
   double command_timeout_s = 0.2;
   uint32_t tick_budget_ns = 90'000;  ///< execution-time budget; 0: not checked

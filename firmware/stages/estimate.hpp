@@ -19,6 +19,24 @@ struct Estimate {
   /// The state at the start of the period this tick's input acts on (x predicted over the PWM
   /// latency; x itself without latency), position wrapped to (-pi, pi]: what the law acts on.
   control::RotorFrameState<T> x_input;
+  /// The stator current the exact model predicted for this tick at the last one, from the
+  /// current measured then, the flux estimate and the input that acted, in the stator frame
+  /// (the phase-loss check compares it with the measured current); false at the first tick.
+  bool current_predicted = false;
+  control::Vec2<T> i_predicted_alphabeta_A = control::Vec2<T>::Zero();
+};
+
+/// The exact model's current row, I~_{k+1} = a21 Phi~_k + a22 I~_k + b2 v~_k (rotor frame):
+/// the current one period ahead. Tick context.
+template <typename T>
+struct CurrentPredictor {
+  explicit CurrentPredictor(const control::VoltageFedCoefficients& c) noexcept
+      : a21(T(c.a21)), a22(T(c.a22)), b2(T(c.b2)) {}
+  control::Vec2<T> next_AB_A(const control::Vec2<T>& flux_AB_Wb, const control::Vec2<T>& i_AB_A,
+                             const control::Vec2<T>& v_AB_V) const noexcept {
+    return a21 * flux_AB_Wb + a22 * i_AB_A + b2 * v_AB_V;
+  }
+  T a21, a22, b2;
 };
 
 template <typename T>
@@ -44,7 +62,10 @@ class ObserverEstimator final : public StateEstimator<T> {
  public:
   ObserverEstimator(const control::VoltageFedCoefficients& c, double pole_pairs,
                     double encoder_bandwidth_rad_s)
-      : flux_(c), encoder_(c, {encoder_bandwidth_rad_s}), pole_pairs_(T(pole_pairs)) {}
+      : flux_(c),
+        encoder_(c, {encoder_bandwidth_rad_s}),
+        current_(c),
+        pole_pairs_(T(pole_pairs)) {}
 
   Estimate<T> estimate(const Measurement<T>& m) noexcept override {
     if (m.encoder_first) encoder_.reset(m.theta_encoder_rad);
@@ -55,8 +76,10 @@ class ObserverEstimator final : public StateEstimator<T> {
     e.x.omega_mech_rad_s = encoder_.omega_mech_rad_s();
     e.x.flux_r_AB_Wb = flux_.flux_r_AB_Wb();
     e.load_Nm = encoder_.load_Nm();
-    e.x.i_s_AB_A = control::Rotation<T>::from_angle(pole_pairs_ * e.x.theta_mech_rad)
-                       .apply_inverse(m.i_alphabeta_A);
+    const auto rotor = control::Rotation<T>::from_angle(pole_pairs_ * e.x.theta_mech_rad);
+    e.x.i_s_AB_A = rotor.apply_inverse(m.i_alphabeta_A);
+    e.current_predicted = predicted_;
+    e.i_predicted_alphabeta_A = rotor.apply(i_next_AB_A_);
     i_s_AB_A_ = e.x.i_s_AB_A;
     return e;
   }
@@ -64,6 +87,8 @@ class ObserverEstimator final : public StateEstimator<T> {
   void advance(const control::Vec2<T>& v_acting_AB_V) noexcept override {
     // The flux observer still holds the estimate of this tick until its update.
     encoder_.predict(i_s_AB_A_, flux_.flux_r_AB_Wb(), v_acting_AB_V);
+    i_next_AB_A_ = current_.next_AB_A(flux_.flux_r_AB_Wb(), i_s_AB_A_, v_acting_AB_V);
+    predicted_ = true;
     flux_.update(i_s_AB_A_, v_acting_AB_V);
   }
 
@@ -73,13 +98,18 @@ class ObserverEstimator final : public StateEstimator<T> {
     flux_.continue_from(old.flux_);
     encoder_.continue_from(old.encoder_);
     i_s_AB_A_ = old.i_s_AB_A_;
+    i_next_AB_A_ = old.i_next_AB_A_;
+    predicted_ = old.predicted_;
   }
 
  private:
   control::FluxObserver<T> flux_;
   control::EncoderObserver<T> encoder_;
+  CurrentPredictor<T> current_;
   T pole_pairs_;
-  control::Vec2<T> i_s_AB_A_ = control::Vec2<T>::Zero();  ///< of the last estimate
+  control::Vec2<T> i_s_AB_A_ = control::Vec2<T>::Zero();     ///< of the last estimate
+  control::Vec2<T> i_next_AB_A_ = control::Vec2<T>::Zero();  ///< predicted for the next
+  bool predicted_ = false;
 };
 
 }  // namespace imd::firmware

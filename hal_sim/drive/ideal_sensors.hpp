@@ -31,6 +31,7 @@ class IdealSensors final : public firmware::Sensing<T>, public firmware::StateEs
         load_(coefficients_,
               control::place_load_estimator(coefficients_, config.load_estimator_pole,
                                             config.load_estimator_pole)),
+        current_(coefficients_),
         section_iv_(config.section_iv_load_estimator),
         pole_pairs_(T(motor.pole_pairs)) {}
 
@@ -53,10 +54,15 @@ class IdealSensors final : public firmware::Sensing<T>, public firmware::StateEs
     last_.x.theta_mech_rad = theta_mech_rad_;
     last_.x.flux_r_AB_Wb = section_iv_ ? flux_.flux_r_AB_Wb() : flux_r_AB_Wb_;
     last_.load_Nm = section_iv_ ? load_.load_Nm() : load_Nm_;
+    last_.current_predicted = predicted_;
+    last_.i_predicted_alphabeta_A =
+        control::Rotation<T>::from_angle(pole_pairs_ * theta_mech_rad_).apply(i_next_AB_A_);
     return last_;
   }
 
   void advance(const control::Vec2<T>& v_acting_AB_V) noexcept override {
+    i_next_AB_A_ = current_.next_AB_A(last_.x.flux_r_AB_Wb, last_.x.i_s_AB_A, v_acting_AB_V);
+    predicted_ = true;
     flux_.update(last_.x.i_s_AB_A, v_acting_AB_V);
     load_.update(last_.x.omega_mech_rad_s, last_.x.i_s_AB_A, last_.x.flux_r_AB_Wb, v_acting_AB_V);
   }
@@ -81,11 +87,14 @@ class IdealSensors final : public firmware::Sensing<T>, public firmware::StateEs
   control::VoltageFedCoefficients coefficients_;
   control::FluxObserver<T> flux_;
   control::LoadEstimator<T> load_;
+  firmware::CurrentPredictor<T> current_;
   bool section_iv_;
   T pole_pairs_;
   control::Vec2<T> flux_r_AB_Wb_ = control::Vec2<T>::Zero(), i_s_AB_A_ = control::Vec2<T>::Zero();
   T omega_mech_rad_s_ = T(0), theta_mech_rad_ = T(0), load_Nm_ = T(0);
   firmware::Estimate<T> last_;
+  control::Vec2<T> i_next_AB_A_ = control::Vec2<T>::Zero();  ///< predicted for the next tick
+  bool predicted_ = false;
 };
 
 }  // namespace imd::sim

@@ -75,8 +75,12 @@ firmware::DriveConfig drive_config(const Scenario& s) {
   p.encoder_missing_counts = set.encoder_missing_counts.value_or(p.encoder_missing_counts);
   p.encoder_max_load_share = set.encoder_max_load_share.value_or(p.encoder_max_load_share);
   p.adc_stuck_ticks = set.adc_stuck_ticks.value_or(p.adc_stuck_ticks);
-  p.phase_loss_ratio = set.phase_loss_ratio.value_or(p.phase_loss_ratio);
-  p.phase_loss_min_current_A = set.phase_loss_min_current_A.value_or(p.phase_loss_min_current_A);
+  const double A_per_code = 2.0 * s.adc.full_scale_A / double(1 << s.adc.bits);
+  p.inverter_voltage_error_share =
+      set.inverter_voltage_error_share.value_or(p.inverter_voltage_error_share);
+  // The board's ADC noise, if it is more than the drive's default assumes.
+  p.adc_noise_codes =
+      set.adc_noise_codes.value_or(std::max(p.adc_noise_codes, s.adc.noise_A / A_per_code));
   p.command_timeout_s = set.command_timeout_s.value_or(p.command_timeout_s);
   // Lock-step simulation: the host's wall-clock time per tick is not the MCU's, so the budget
   // is checked only when the scenario sets one.

@@ -101,6 +101,7 @@ Summary run(const Scenario& s, const RunCallbacks& callbacks) {
       }
       summary.faults[event].code = firmware::fault_name(firmware::FaultCode(code));
       summary.faults[event].detected_at_s = t_s;
+      if (code == int(rec.fault)) summary.faults[event].detail = drive.status().fault_detail;
       awaiting_pwm_off.push_back(event);
     }
     last_fault_bits = rec.fault_bits;

@@ -137,11 +137,12 @@ TEST(FaultMatrix, AdcStuck) {
 }
 
 TEST(FaultMatrix, PhaseLoss) {
-  // Judged once per revolution of the flux: at 100 rad/s (one pole pair) a revolution takes
-  // 63 ms, so detection takes at most two.
+  // Judged over windows of the transient time constant (25 ticks): found in the first full
+  // window once the law wants current in the phase, at most a sixth of an electrical
+  // revolution after its zero crossing (10 ms at 100 rad/s, one pole pair): 15 ms.
   FaultInjection f = at(kInject_s, FaultKind::phase_loss);
   f.phase = 2;
-  run_case(base("seed000_realistic.toml"), {f, "phase_loss", 0.13});
+  run_case(base("seed000_realistic.toml"), {f, "phase_loss", 0.015});
 }
 
 TEST(FaultMatrix, Overrun) {

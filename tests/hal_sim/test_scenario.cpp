@@ -97,8 +97,9 @@ TEST(Scenario, BadInputNamesTheKey) {
        "protection.encoder_missing_counts: = 0: must be > 0"},
       {{"protection.encoder_max_load_share=1.5"},
        "protection.encoder_max_load_share: = 1.5: must be in (0, 1)"},
-      {{"protection.phase_loss_ratio=1"}, "protection.phase_loss_ratio: = 1: must be in (0, 1)"},
-      {{"protection.phase_loss_ratio=0"}, "protection.phase_loss_ratio: = 0: must be > 0"},
+      {{"protection.inverter_voltage_error_share=1"},
+       "protection.inverter_voltage_error_share: = 1: must be in (0, 1)"},
+      {{"protection.adc_noise_codes=0"}, "protection.adc_noise_codes: = 0: must be > 0"},
       {{"protection.overcurrent_A=0"}, "protection.overcurrent_A: = 0: must be > 0"},
       {{"protection.tick_budget_us=-5"}, "protection.tick_budget_us: = -5: must be > 0"},
       {{"protection.command_timeout_s=inf"}, "protection.command_timeout_s: = inf: must be finite"},
@@ -153,7 +154,7 @@ TEST(Scenario, EventsAndSupervisionDefaultToNone) {
   const ProtectionSettings& p = s.protection;
   for (const auto* value :
        {&p.overcurrent_A, &p.bus_min_V, &p.bus_max_V, &p.overspeed_rad_s, &p.encoder_missing_counts,
-        &p.phase_loss_ratio, &p.phase_loss_min_current_A, &p.command_timeout_s, &p.tick_budget_us,
+        &p.inverter_voltage_error_share, &p.adc_noise_codes, &p.command_timeout_s, &p.tick_budget_us,
         &p.stop_decel_rad_s2}) {
     EXPECT_FALSE(value->has_value());
   }
@@ -168,8 +169,8 @@ TEST(Scenario, CanAndProtectionTables) {
       kPaper, {"can.node_id=5", "can.telemetry_rate_Hz=250", "protection.overcurrent_A=12",
                "protection.bus_min_V=200", "protection.bus_max_V=400",
                "protection.overspeed_rad_s=350", "protection.encoder_missing_counts=6.5",
-               "protection.adc_stuck_ticks=4", "protection.phase_loss_ratio=0.3",
-               "protection.phase_loss_min_current_A=0.5", "protection.command_timeout_s=0.2",
+               "protection.adc_stuck_ticks=4", "protection.inverter_voltage_error_share=0.03",
+               "protection.adc_noise_codes=2.5", "protection.command_timeout_s=0.2",
                "protection.tick_budget_us=80", "protection.stop_decel_rad_s2=500"});
   EXPECT_EQ(s.can_node_id, 5);
   EXPECT_EQ(s.telemetry_rate_Hz, 250.0);
@@ -180,8 +181,8 @@ TEST(Scenario, CanAndProtectionTables) {
   EXPECT_EQ(p.overspeed_rad_s, 350.0);
   EXPECT_EQ(p.encoder_missing_counts, 6.5);
   EXPECT_EQ(p.adc_stuck_ticks, 4);
-  EXPECT_EQ(p.phase_loss_ratio, 0.3);
-  EXPECT_EQ(p.phase_loss_min_current_A, 0.5);
+  EXPECT_EQ(p.inverter_voltage_error_share, 0.03);
+  EXPECT_EQ(p.adc_noise_codes, 2.5);
   EXPECT_EQ(p.command_timeout_s, 0.2);
   EXPECT_EQ(p.tick_budget_us, 80.0);
   EXPECT_EQ(p.stop_decel_rad_s2, 500.0);

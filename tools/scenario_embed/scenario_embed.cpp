@@ -25,7 +25,7 @@ using imd::firmware::ControllerKind;
 using imd::firmware::DriveConfig;
 
 // A new field must be written here too: these sizes fail the build until it is.
-static_assert(sizeof(DriveConfig) == 456, "DriveConfig changed: write its new fields below");
+static_assert(sizeof(DriveConfig) == 448, "DriveConfig changed: write its new fields below");
 static_assert(sizeof(imd::sim::SimBoardConfig) == 152, "SimBoardConfig changed: write it below");
 static_assert(sizeof(imd::control::MotorParameters) == 64, "MotorParameters changed");
 
@@ -171,9 +171,8 @@ void write_drive(Writer& w, const DriveConfig& c) {
   w.number("drive.protection.encoder_missing_counts", p.encoder_missing_counts);
   w.number("drive.protection.encoder_max_load_share", p.encoder_max_load_share);
   w.integer("drive.protection.adc_stuck_ticks", p.adc_stuck_ticks);
-  w.number("drive.protection.phase_loss_ratio", p.phase_loss_ratio);
-  w.number("drive.protection.phase_loss_min_current_A", p.phase_loss_min_current_A);
-  w.number("drive.protection.phase_loss_max_window_s", p.phase_loss_max_window_s);
+  w.number("drive.protection.inverter_voltage_error_share", p.inverter_voltage_error_share);
+  w.number("drive.protection.adc_noise_codes", p.adc_noise_codes);
   w.number("drive.protection.command_timeout_s", p.command_timeout_s);
   w.line("drive.protection.tick_budget_ns", fmt::format("{}u", p.tick_budget_ns));
   w.integer("drive.stage_timing_period_ticks", c.stage_timing_period_ticks);
