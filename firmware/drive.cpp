@@ -1,6 +1,7 @@
 #include "firmware/drive.hpp"
 
 #include "control/svpwm.hpp"
+#include "firmware/duration_ticks.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -44,7 +45,8 @@ Drive<T>::Drive(const std::optional<MotorRecord>& record, const DriveConfig& con
                   config.adc_calibration_ticks <= 0),
       clock_Hz_(peripherals.timer.execution_clock_Hz()),
       ns_per_count_(static_cast<float>(1e9 / double(clock_Hz_))),
-      limited_(limited_window_ticks(config)) {
+      limited_(limited_window_ticks(config)),
+      brake_release_ticks_(duration_ticks(config.brake_release_time_s, config.sample_period_s)) {
   protection_.set_clock(clock_Hz_);
   hw_.pwm.disable();
 }
@@ -67,7 +69,12 @@ void Drive<T>::on_tick() noexcept {
   clock.lap(Stage::law);
   const Modulation<T> out = modulate(plan, u, e, m, model);
   clock.lap(Stage::modulate);
-  const Trip trip = protection_.check(m, e, plan.supervised, u, out, u_written_V_,
+  SupervisedState supervised = plan.supervised;
+  supervised.brake_may_hold =
+      config_.brake_output_line >= 0 &&
+      (!brake_line_level_ ||
+       k < brake_released_tick_ + brake_release_ticks_);
+  const Trip trip = protection_.check(m, e, supervised, u, out, u_written_V_,
                                       e.valid ? &model->checks : nullptr);
   clock.lap(Stage::protect);
   actuate(k, e, out, trip, model);
@@ -113,8 +120,27 @@ Modulation<T> Drive<T>::identify(const Measurement<T>& m) noexcept {
   for (int phase = 0; phase < 3; ++phase) out.duty[phase] = static_cast<float>(pwm.duty[phase]);
   out.clipped = pwm.clipped;
   out.finite = std::isfinite(out.u_alphabeta_V.x()) && std::isfinite(out.u_alphabeta_V.y());
+  out.direct = true;
   supervisor_.identification_progress(identifier_->step_code(),
                                       static_cast<float>(identifier_->fraction()));
+  return out;
+}
+
+template <typename T>
+Modulation<T> Drive<T>::dc_brake(const Measurement<T>& m, const Estimate<T>& e,
+                                 MotorModel<T>& model) noexcept {
+  Modulation<T> out;
+  out.u_alphabeta_V = model.dc_brake.step(m.i_alphabeta_A, model.limits.v_max_V(m.v_bus_V));
+  const control::SvpwmResult<T> pwm = control::svpwm(out.u_alphabeta_V, m.v_bus_V);
+  for (int phase = 0; phase < 3; ++phase) out.duty[phase] = static_cast<float>(pwm.duty[phase]);
+  out.clipped = pwm.clipped;
+  out.finite = std::isfinite(out.u_alphabeta_V.x()) && std::isfinite(out.u_alphabeta_V.y());
+  out.direct = true;
+  // What acts, for the observers (their position is the failed encoder's: of no use now).
+  out.u_acting_alphabeta_V = out.u_alphabeta_V;
+  out.v_acting_AB_V =
+      control::Rotation<T>::from_angle(T(model.motor.pole_pairs) * e.x.theta_mech_rad)
+          .apply_inverse(out.u_alphabeta_V);
   return out;
 }
 
@@ -182,6 +208,7 @@ inline Modulation<T> Drive<T>::modulate(const TickPlan<T>& plan, const LawOutput
                                         MotorModel<T>* model) noexcept {
   if (plan.mode == Mode::identifying) return identify(m);
   if (plan.mode == Mode::off || model == nullptr) return {};
+  if (plan.mode == Mode::dc_braking) return dc_brake(m, e, *model);
   PowerStage<T>& stage =
       substitutes_.power_stage != nullptr ? *substitutes_.power_stage : model->svpwm;
   return stage.modulate(u, e.x_input, m.v_bus_V);
@@ -192,14 +219,25 @@ inline void Drive<T>::actuate(uint64_t k, const Estimate<T>& e, const Modulation
                               const Trip& trip, MotorModel<T>* model) noexcept {
   v_applied_V_ = Vec2::Zero();
   Vec2 u_applied_V = Vec2::Zero();
-  if (trip.any()) {
-    supervisor_.latch(trip, k);
+  // A fault takes its stop: STO turns the PWM off now; a controlled stop (SS1, DC braking)
+  // starts from the next tick, this tick's output still written.
+  StopContext<T> motion;
+  if (trip.any() && model != nullptr && e.valid && substitutes_.power_stage == nullptr &&
+      !supervisor_.fault_stopping()) {
+    motion.omega_mech_rad_s = e.x.omega_mech_rad_s;
+    motion.dc_brake_ticks = model->dc_brake.begin(e.x.omega_mech_rad_s);
+  }
+  if (trip.any() && supervisor_.latch(trip, k, motion)) {
     pwm_off();
     u_written_V_ = Vec2::Zero();
-  } else if (supervisor_.state() == DriveState::identifying) {
-    hw_.pwm.set_duties(out.duty);  // the commissioning's own voltage, no inner feedback
+  } else if (supervisor_.state() == DriveState::identifying || (out.direct && model != nullptr)) {
+    hw_.pwm.set_duties(out.duty);  // the commissioning's or DC braking's own voltage
     hw_.pwm.enable();
     u_written_V_ = out.u_alphabeta_V;
+    if (supervisor_.state() != DriveState::identifying) {
+      v_applied_V_ = out.v_acting_AB_V;
+      u_applied_V = out.u_acting_alphabeta_V;
+    }
   } else if (supervisor_.modulating() && model != nullptr) {
     PowerStage<T>& stage =
         substitutes_.power_stage != nullptr ? *substitutes_.power_stage : model->svpwm;
@@ -231,7 +269,7 @@ inline void Drive<T>::check_budget(uint64_t k, uint32_t counts, MotorModel<T>* m
   const Trip overrun = protection_.over_budget(counts);
   if (!overrun.any()) return;
   ++execution_.overruns;
-  supervisor_.latch(overrun, k);
+  supervisor_.latch(overrun, k);  // STO
   pwm_off();                      // the PWM is off before the next period starts
   if (model != nullptr) model->predictor.cancel_in_flight();  // this tick's voltage never acts
 }
@@ -285,10 +323,20 @@ inline void Drive<T>::publish(uint64_t k, const Measurement<T>& m, const Estimat
     telemetry_.publish(k, *hw_.can, r, status, supervisor_.machine(), execution_,
                        config_.protection.tick_budget_ns);
   }
-  const bool faulted = status.state == DriveState::fault;
+  const bool faulted = status.state == DriveState::fault || supervisor_.fault_stopping();
   if (faulted != fault_line_level_) {
     write_line(config_.fault_output_line, faulted);  // on change only: a system call on Linux
     fault_line_level_ = faulted;
+  }
+  // The holding brake: released only while a law controls the motion (and the PWM is on).
+  const bool release = supervisor_.brake_released() && hw_.pwm.enabled();
+  status.brake_engaged = !release;
+  r.brake_engaged = !release;
+  r.stop = status.stop;
+  if (release != brake_line_level_) {
+    write_line(config_.brake_output_line, release);
+    brake_line_level_ = release;
+    if (release) brake_released_tick_ = k;
   }
 }
 

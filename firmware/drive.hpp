@@ -129,6 +129,9 @@ class Drive final : public hal::TickHandler {
                                                 MotorModel<T>* model) noexcept;
   /// The commissioning's tick: its voltage from the measured current, straight to SVPWM.
   Modulation<T> identify(const Measurement<T>& m) noexcept;
+  /// A fault's DC braking: its stator voltage from the measured current, straight to SVPWM.
+  Modulation<T> dc_brake(const Measurement<T>& m, const Estimate<T>& e,
+                         MotorModel<T>& model) noexcept;
   /// After the tick: a finished commissioning hands its result to the service loop.
   void end_identification(uint64_t k) noexcept;
   // The service loop's side of the commissioning.
@@ -180,10 +183,13 @@ class Drive final : public hal::TickHandler {
   Vec2 v_applied_V_ = Vec2::Zero();  ///< rotor-frame input written this tick (zero if off)
   Vec2 u_last_period_V_ = Vec2::Zero();  ///< stator voltage that acted over [k-1, k]
   bool fault_line_level_ = false;
+  bool brake_line_level_ = false;  ///< released (driven) or engaged
+  uint64_t brake_released_tick_ = 0;  ///< when the line last released the brake
   int ticks_since_timed_ = 0;  ///< for the stage timing of one tick in N
   TickRecord<T> record_;
   ExecutionStats execution_;
   LimitedMonitor limited_;  ///< whether a limit holds the running drive back
+  uint64_t brake_release_ticks_;  ///< the brake's release time
 };
 
 }  // namespace imd::firmware

@@ -109,6 +109,12 @@ struct DriveConfig {
   /// refuses enable, and losing it while the PWM is on trips fault enable_input.
   int enable_input_line = -1;
   int fault_output_line = -1;   ///< active while a fault is latched
+  /// Active (driven) to release the holding brake: only while the drive runs or ramps to a
+  /// controlled stop; a spring-applied brake engages when the line drops or loses power.
+  int brake_output_line = -1;
+  /// The brake's release time (its datasheet's): after the line releases it, the brake may
+  /// still hold the rotor this long.
+  double brake_release_time_s = 0.1;
   int timing_output_line = -1;  ///< active while the tick computes (to watch on a scope)
 
   // Disable: ramp to a stop, then PWM off.

@@ -14,6 +14,7 @@
 #include "firmware/drive_config.hpp"
 #include "firmware/laws/law_registry.hpp"
 #include "firmware/protection/protection.hpp"
+#include "firmware/stages/dc_brake.hpp"
 #include "firmware/stages/estimate.hpp"
 #include "firmware/stages/input_limits.hpp"
 #include "firmware/stages/latency_predictor.hpp"
@@ -57,6 +58,7 @@ struct MotorModel {
               {config.compensate_dead_time, config.dead_time_s, config.sample_period_s,
                control::derive_voltage_fed(m).sigma_H}),
         checks(m, coefficients, config, board.encoder_counts_per_rev, board.adc_A_per_code),
+        dc_brake(m, config),
         rotor_resistance(m, mras_config(config), nominal_Rr_Ohm > 0.0 ? nominal_Rr_Ohm : m.Rr_Ohm) {}
   MotorModel(const MotorModel&) = delete;
   MotorModel& operator=(const MotorModel&) = delete;
@@ -80,6 +82,7 @@ struct MotorModel {
   InputLimits<T> limits;
   SvpwmStage<T> svpwm;
   MotorChecks<T> checks;
+  DcBrake<T> dc_brake;
   control::RotorResistanceMras<T> rotor_resistance;
 };
 

@@ -39,6 +39,7 @@ Supervisor<T>::Supervisor(const DriveConfig& config, const SupervisorWiring& wir
           std::min(config.max_accel_rad_s2, config.stop_decel_rad_s2), config.sample_period_s)),
       stop_speed_rad_s_(T(config.stop_speed_rad_s)),
       stop_timeout_ticks_(duration_ticks(config.stop_timeout_s, config.sample_period_s)),
+      stop_policy_(config.protection.stop),
       calibrated_(calibrated),
       record_complete_(laws != nullptr),
       record_saved_(laws != nullptr) {
@@ -135,12 +136,19 @@ TickPlan<T> Supervisor<T>::plan(uint64_t k, const Measurement<T>& m,
         if (p.stopping) p.ahead.torque_Nm = T(0);
       }
     }
-    // A stop is complete once the ramp is at zero and the motor (nearly) still.
-    if (p.stopping &&
-        ((ramp_.value() == T(0) && std::abs(e.x.omega_mech_rad_s) < stop_speed_rad_s_) ||
-         k - stop_start_tick_ > stop_timeout_ticks_)) {
-      machine_.go(DriveState::idle, TransitionReason::stopped, k);
-      p.mode = Mode::off;
+    if (fault_stop_ && status_.stop == StopCategory::dc_brake) {
+      p.mode = Mode::dc_braking;
+      if (k >= dc_brake_end_tick_) end_fault_stop(k, p);
+    } else if (p.stopping &&
+               ((ramp_.value() == T(0) && std::abs(e.x.omega_mech_rad_s) < stop_speed_rad_s_) ||
+                k - stop_start_tick_ > stop_timeout_ticks_)) {
+      // A stop is complete once the ramp is at zero and the motor (nearly) still.
+      if (fault_stop_) {
+        end_fault_stop(k, p);
+      } else {
+        machine_.go(DriveState::idle, TransitionReason::stopped, k);
+        p.mode = Mode::off;
+      }
     }
   } else if (e.valid) {
     p.next = references_.at_tick(k);  // what the drive would aim at once enabled
@@ -149,6 +157,7 @@ TickPlan<T> Supervisor<T>::plan(uint64_t k, const Measurement<T>& m,
   s.modulating = modulating();
   s.enable_input = enable_input_;
   s.magnetizing = machine_.state() == DriveState::magnetizing;
+  s.dc_braking = p.mode == Mode::dc_braking;
   s.magnetizing_ticks = saturated_ticks(k - magnetizing_start_tick_);
   s.watchdog_armed = commands_over_can_ && (machine_.state() == DriveState::magnetizing ||
                                             machine_.state() == DriveState::running);
@@ -184,10 +193,27 @@ inline void Supervisor<T>::references(uint64_t k, const Estimate<T>& e, TickPlan
 }
 
 template <typename T>
-void Supervisor<T>::latch(const Trip& trip, uint64_t k) noexcept {
+bool Supervisor<T>::latch(const Trip& trip, uint64_t k, const StopContext<T>& motion) noexcept {
   commanded_.set_speed(T(0));  // after clear and enable, the host sends a new speed
   status_.fault_bits = static_cast<uint16_t>(status_.fault_bits | trip.bits);
-  if (machine_.state() == DriveState::fault) return;  // the first fault is kept
+  if (machine_.state() == DriveState::fault) return true;  // the first fault is kept
+  StopCategory stop = stop_category(trip.bits, stop_policy_);
+  // A controlled stop needs a law that runs on a magnetized motor; DC braking, motion to stop.
+  const bool controlled = machine_.state() == DriveState::running ||
+                          machine_.state() == DriveState::stopping;
+  if (!controlled || (stop == StopCategory::dc_brake &&
+                      (motion.dc_brake_ticks == 0 ||
+                       !(std::abs(motion.omega_mech_rad_s) > stop_speed_rad_s_)))) {
+    stop = StopCategory::sto;
+  }
+  if (fault_stop_) {  // an earlier fault's stop runs: only STO overrides it
+    if (stop != StopCategory::sto) return false;
+    fault_stop_ = false;
+    status_.stop = StopCategory::sto;
+    machine_.go(DriveState::fault, TransitionReason::fault, k);
+    status_.state = DriveState::fault;
+    return true;
+  }
   if (machine_.state() == DriveState::identifying) {
     status_.identify_step = 5;     // failed
     status_.identify_failure = 5;  // aborted (by the fault)
@@ -195,9 +221,29 @@ void Supervisor<T>::latch(const Trip& trip, uint64_t k) noexcept {
   status_.first_fault = trip.first;
   status_.first_fault_tick = k;
   status_.fault_detail = trip.detail;
-  machine_.go(DriveState::fault, TransitionReason::fault, k);
-  status_.state = DriveState::fault;
+  status_.stop = stop;
+  if (stop == StopCategory::sto) {
+    machine_.go(DriveState::fault, TransitionReason::fault, k);
+  } else {
+    fault_stop_ = true;
+    if (machine_.state() == DriveState::running) {
+      machine_.go(DriveState::stopping, TransitionReason::fault, k);
+    }
+    stop_start_tick_ = k;
+    ramp_.set_max_step(stop_accel_step_rad_s_);
+    dc_brake_end_tick_ = k + motion.dc_brake_ticks;
+  }
+  status_.state = machine_.state();
   if (wiring_.can != nullptr) wiring_.telemetry.report_fault(*wiring_.can, status_);
+  return stop == StopCategory::sto;
+}
+
+template <typename T>
+void Supervisor<T>::end_fault_stop(uint64_t k, TickPlan<T>& p) noexcept {
+  fault_stop_ = false;
+  machine_.go(DriveState::fault, TransitionReason::stopped, k);
+  status_.state = DriveState::fault;
+  p.mode = Mode::off;
 }
 
 template <typename T>

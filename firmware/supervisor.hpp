@@ -14,6 +14,7 @@
 #include "firmware/laws/law_registry.hpp"
 #include "firmware/parameters/parameter_bank.hpp"
 #include "firmware/protection/protection.hpp"
+#include "firmware/protection/stop_category.hpp"
 #include "firmware/protection/trip.hpp"
 #include "firmware/protocol/commands.hpp"
 #include "firmware/reference_source.hpp"
@@ -34,6 +35,14 @@ enum class Mode : uint8_t {
   magnetizing,  ///< the magnetizing current
   controlling,  ///< the selected law (running or stopping)
   identifying,  ///< the commissioning drives the motor
+  dc_braking,   ///< a fault's DC-injection stop (firmware/stages/dc_brake.hpp)
+};
+
+/// What a fault's stop needs to know of the motion when it latches.
+template <typename T>
+struct StopContext {
+  T omega_mech_rad_s = T(0);  ///< the speed estimate at detection
+  uint64_t dc_brake_ticks = 0;  ///< how long DC braking takes from there; 0: not possible
 };
 
 template <typename T>
@@ -71,9 +80,12 @@ class Supervisor {
   /// Commands, then the transitions the measurement and the estimate call for, then the
   /// references.
   TickPlan<T> plan(uint64_t k, const Measurement<T>& m, const Estimate<T>& e) noexcept;
-  /// Latches the faults the protect stage found (the first one keeps its code and time). The
-  /// caller turns the PWM off.
-  void latch(const Trip& trip, uint64_t k) noexcept;
+  /// Latches the faults the protect stage found (the first one keeps its code and time) and
+  /// starts their stop (firmware/protection/stop_category.hpp). True: STO, the caller turns the
+  /// PWM off now; false: a controlled stop (SS1 or DC braking) runs, or continues, first.
+  bool latch(const Trip& trip, uint64_t k, const StopContext<T>& motion = {}) noexcept;
+  /// A fault's controlled stop is under way (the state is stopping, the fault latched).
+  bool fault_stopping() const noexcept { return fault_stop_; }
   /// The program running the drive ends: to idle if modulating (the motor coasts).
   void shut_down(uint64_t k) noexcept;
   /// The commissioning run ended at tick k: with a result (`done`), or with `failure`.
@@ -86,6 +98,11 @@ class Supervisor {
 
   DriveState state() const noexcept { return machine_.state(); }
   bool modulating() const noexcept;
+  /// The holding brake may be released: the drive runs, or ramps to a controlled stop.
+  bool brake_released() const noexcept {
+    return machine_.state() == DriveState::running ||
+           (machine_.state() == DriveState::stopping && status_.stop != StopCategory::dc_brake);
+  }
   const DriveStatus& status() const noexcept { return status_; }
   DriveStatus& status() noexcept { return status_; }
   const StateMachine& machine() const noexcept { return machine_; }
@@ -103,7 +120,9 @@ class Supervisor {
   protocol::CommandResult apply(const protocol::Command& command, uint64_t k,
                                 TickPlan<T>& p) noexcept;
   void enable(uint64_t k, TickPlan<T>& p) noexcept;
-  void clear_faults(uint64_t k, TickPlan<T>& p) noexcept;
+  protocol::CommandResult clear_faults(uint64_t k, TickPlan<T>& p) noexcept;
+  /// A fault's controlled stop ended (at standstill, or at its time limit): STO.
+  void end_fault_stop(uint64_t k, TickPlan<T>& p) noexcept;
   bool read_enable_input() const noexcept;
   void select(ControllerKind kind) noexcept;
   /// The state the drive rests in once calibrated: idle, or unconfigured without a model.
@@ -134,6 +153,9 @@ class Supervisor {
   T command_accel_step_rad_s_, stop_accel_step_rad_s_;  ///< per period
   T stop_speed_rad_s_;
   uint64_t stop_timeout_ticks_;
+  StopPolicy stop_policy_;
+  bool fault_stop_ = false;          ///< a fault's SS1 or DC braking runs
+  uint64_t dc_brake_end_tick_ = 0;
   bool calibrated_;
   bool record_complete_, record_saved_;  ///< as the last parameter answer said
   T v_bus_V_ = T(0);                     ///< measured this tick (the commissioning's plan)

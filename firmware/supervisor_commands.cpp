@@ -37,14 +37,19 @@ void Supervisor<T>::enable(uint64_t k, TickPlan<T>& p) noexcept {
 }
 
 template <typename T>
-void Supervisor<T>::clear_faults(uint64_t k, TickPlan<T>& p) noexcept {
+protocol::CommandResult Supervisor<T>::clear_faults(uint64_t k, TickPlan<T>& p) noexcept {
+  // Not before a fault's controlled stop has ended in STO; without a fault, nothing to clear.
+  if (fault_stop_) return protocol::CommandResult::not_allowed;
+  if (machine_.state() != DriveState::fault) return protocol::CommandResult::accepted;
   // A fault during the offset calibration leaves the offsets unknown: calibrate again.
   const DriveState next = calibrated_ ? rest_state() : DriveState::calibrating;
-  if (!machine_.go(next, TransitionReason::clear_faults, k)) return;
+  if (!machine_.go(next, TransitionReason::clear_faults, k)) return protocol::CommandResult::accepted;
   status_.fault_bits = 0;
   status_.first_fault = FaultCode::none;
   status_.fault_detail = 0;
+  status_.stop = StopCategory::none;
   p.supervised.restarted = true;
+  return protocol::CommandResult::accepted;
 }
 
 template <typename T>
@@ -76,15 +81,14 @@ protocol::CommandResult Supervisor<T>::apply(const protocol::Command& c, uint64_
         identification_ended(k, false, 5);  // aborted
       } else if (s == DriveState::magnetizing) {  // no motion to stop yet: the PWM goes off
         machine_.go(DriveState::idle, TransitionReason::disable, k);
-      } else if (s == DriveState::running) {
+      } else if (s == DriveState::running) {  // (a fault's stop runs on: disable is moot)
         machine_.go(DriveState::stopping, TransitionReason::disable, k);
         stop_start_tick_ = k;
         ramp_.set_max_step(stop_accel_step_rad_s_);
       }
       return CommandResult::accepted;
     case CommandKind::clear_faults:
-      clear_faults(k, p);
-      return CommandResult::accepted;
+      return clear_faults(k, p);
     case CommandKind::set_speed:
       if (!commands_over_can_) return CommandResult::not_allowed;
       commanded_.set_speed(T(c.value));
@@ -211,7 +215,7 @@ void Supervisor<T>::answer_parameter(const ParameterAnswer& a) noexcept {
 #define IMD_INSTANTIATE_COMMANDS(T)                                                         \
   template void Supervisor<T>::receive_commands(uint64_t, TickPlan<T>&) noexcept;           \
   template void Supervisor<T>::enable(uint64_t, TickPlan<T>&) noexcept;                     \
-  template void Supervisor<T>::clear_faults(uint64_t, TickPlan<T>&) noexcept;               \
+  template protocol::CommandResult Supervisor<T>::clear_faults(uint64_t, TickPlan<T>&) noexcept; \
   template protocol::CommandResult Supervisor<T>::apply(const protocol::Command&, uint64_t, \
                                                         TickPlan<T>&) noexcept;            \
   template protocol::CommandResult Supervisor<T>::access_parameter(                         \

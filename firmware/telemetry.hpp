@@ -8,6 +8,7 @@
 
 #include "firmware/drive_state.hpp"
 #include "firmware/execution_stats.hpp"
+#include "firmware/protection/stop_category.hpp"
 #include "firmware/protocol/commands.hpp"
 #include "firmware/state_machine.hpp"
 #include "firmware/tick_record.hpp"
@@ -27,6 +28,8 @@ struct DriveStatus {
   uint32_t rejected_commands = 0;
   bool can_bus_off = false;
   Limitation limited = Limitation::none;  ///< a limit holds the running drive back
+  StopCategory stop = StopCategory::none;  ///< how the latched fault stops the drive
+  bool brake_engaged = true;               ///< the holding brake (engaged unless running)
   // The last commissioning run: its step (kIdentifyStepValues; 6 none yet), progress and end.
   uint8_t identify_step = 6;
   float identify_fraction = 0.0f;

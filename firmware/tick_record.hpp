@@ -7,6 +7,7 @@
 #include "control/frames.hpp"
 #include "firmware/drive_state.hpp"
 #include "firmware/laws/control_law.hpp"
+#include "firmware/protection/stop_category.hpp"
 #include "firmware/stages/stage_clock.hpp"
 
 namespace imd::firmware {
@@ -40,6 +41,8 @@ struct TickRecord {
   bool voltage_clipped = false;
   LawDiagnostics<T> law;
   Limitation limited = Limitation::none;  ///< held for the monitor's window (limitation.hpp)
+  StopCategory stop = StopCategory::none;  ///< the latched fault's stop
+  bool brake_engaged = true;               ///< the holding brake line not driven
   // Execution time: the tick up to the PWM write, and each stage in execution-clock counts,
   // measured on the ticks with stages_timed (publish's only after the record was sent).
   uint32_t exec_ns = 0;

@@ -93,7 +93,7 @@ StateVector InductionMotorPlant::voltage_fed_derivative(const StateVector& x, co
                      k_.gamma_per_s * current + u / k_.sigma_H;
   // Floating terminals cancel dI/dt along the open phases' axes.
   if (open_phases_ != 0) dx.segment<2>(2) = constrained(dx.segment<2>(2));
-  dx(4) = (torque - motor_.friction_Nms * omega - load_Nm) / motor_.J_kgm2;
+  dx(4) = (torque + shaft_torque_Nm(omega, load_Nm)) / motor_.J_kgm2;
   dx(5) = omega;
   return dx;
 }
@@ -184,6 +184,16 @@ void InductionMotorPlant::step_analog_feedback(const Vec2& v_AB_V, double load_N
       load_Nm);
 }
 
+double InductionMotorPlant::shaft_torque_Nm(double omega_rad_s, double load_Nm) const noexcept {
+  double brake_Nm = 0.0;
+  if (brake_Nm_ > 0.0) {
+    const double h_s = config_.period_s / config_.rk4_substeps;
+    const double omega_eps = brake_Nm_ * h_s / motor_.J_kgm2;
+    brake_Nm = brake_Nm_ * std::clamp(omega_rad_s / omega_eps, -1.0, 1.0);
+  }
+  return -motor_.friction_Nms * omega_rad_s - load_Nm - brake_Nm;
+}
+
 void InductionMotorPlant::step_current_fed(const Vec2& i_s_AB_A, double load_Nm) noexcept {
   // The current is algebraic, I = e^{p th J} i_AB; only Phi, w and th are integrated. The
   // current slots of the state vector carry I and have zero derivative in the integrator.
@@ -199,7 +209,7 @@ void InductionMotorPlant::step_current_fed(const Vec2& i_s_AB_A, double load_Nm)
     dx.segment<2>(0) = -k_.alpha_per_s * flux + p * x(4) * control::J_times(flux) +
                        k_.alpha_per_s * motor_.Lm_H * current;
     dx.segment<2>(2).setZero();
-    dx(4) = (torque - motor_.friction_Nms * x(4) - load_Nm) / motor_.J_kgm2;
+    dx(4) = (torque + shaft_torque_Nm(x(4), load_Nm)) / motor_.J_kgm2;
     dx(5) = x(4);
     return dx;
   };

@@ -89,6 +89,13 @@ class InductionMotorPlant {
     set_open_phases(phase ? 1u << *phase : 0u);
   }
 
+  /// A holding brake's torque on the shaft: 0 released, T_b engaged. It opposes the motion up
+  /// to T_b, and holds the rotor against any smaller torque. Modelled as friction that is
+  /// viscous below w_eps = T_b h / J (h the RK4 step): stiff enough that a held rotor creeps at
+  /// most at (torque / T_b) w_eps, mild enough for the step (T_b h / (J w_eps) = 1).
+  void set_brake_torque(double holding_Nm) noexcept { brake_Nm_ = holding_Nm; }
+  double brake_torque() const noexcept { return brake_Nm_; }
+
   /// One period with the stator voltage u held (stationary frame).
   void step_voltage(const Vec2& u_s_alphabeta_V, double load_Nm) noexcept;
   /// One period with u held plus `error` of the instantaneous stator current.
@@ -137,6 +144,8 @@ class InductionMotorPlant {
   /// A stator current (or its derivative) under the open phases' constraint: as is with none
   /// open, without the open axis' component with one, zero with more.
   Vec2 constrained(const Vec2& current) const noexcept;
+  /// The shaft's torques besides the motor's at speed w: friction, load and the brake.
+  double shaft_torque_Nm(double omega_rad_s, double load_Nm) const noexcept;
 
   control::MotorParameters motor_;
   control::VoltageFedConstants k_;
@@ -145,6 +154,7 @@ class InductionMotorPlant {
   double time_s_ = 0.0;
   double period_ripple_sq_A2_ = 0.0;
   unsigned open_phases_ = 0;
+  double brake_Nm_ = 0.0;
   Vec2 open_axis_ = Vec2::Zero();  ///< axis of the open phase when exactly one is open
 };
 

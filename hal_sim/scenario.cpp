@@ -307,6 +307,9 @@ Scenario load_scenario(const std::filesystem::path& path, const std::vector<std:
   }
   s.switching_inverter =
       r.choice("inverter.model", "average", {"average", "switching"}) == "switching";
+  s.brake.holding_torque_Nm = r.non_negative("brake.holding_torque_Nm", 0.0);
+  s.brake.engage_delay_s = r.non_negative("brake.engage_delay_s", s.brake.engage_delay_s);
+  s.brake.release_delay_s = r.non_negative("brake.release_delay_s", s.brake.release_delay_s);
   s.dead_time_compensation = r.boolean("drive.dead_time_compensation", true);
   s.dsmc_speed_channel = r.choice("drive.dsmc_speed_channel", "torque", {"torque", "paper"});
   s.dsmc_speed_bandwidth_rad_s = r.number("drive.dsmc_speed_bandwidth_rad_s", 0.0);

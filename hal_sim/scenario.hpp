@@ -53,6 +53,10 @@ struct ProtectionSettings {
   std::optional<double> command_timeout_s;  ///< command watchdog on CAN commands
   std::optional<double> tick_budget_us;     ///< execution-time budget of a tick
   std::optional<double> stop_decel_rad_s2;  ///< deceleration of the stop on a disable command
+  /// The stop categories of the faults that may choose (firmware StopPolicy): "sto", "ss1",
+  /// "dc_brake".
+  std::string command_timeout_stop = "ss1", emergency_stop_stop = "sto", encoder_stop = "dc_brake";
+  std::optional<double> dc_brake_current_share;  ///< DC braking's current, (0, 1] of the limit
 };
 
 /// [nameplate] and [identify]: a commissioning run (docs/scenarios.md). The drive starts with an
@@ -118,6 +122,7 @@ struct Scenario {
   double magnetizing_current_A = 0.0;  ///< 0: the current that holds the flux target
 
   LoadProfile load;
+  HoldingBrake brake;  ///< [brake]: a holding brake on the shaft (none by default)
 
   // [sensors]
   bool ideal_sensors = false;

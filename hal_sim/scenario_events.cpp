@@ -212,6 +212,14 @@ void read_protection(Reader& r, Scenario& s) {
   p.command_timeout_s = r.optional_positive("protection.command_timeout_s");
   p.tick_budget_us = r.optional_positive("protection.tick_budget_us");
   p.stop_decel_rad_s2 = r.optional_positive("protection.stop_decel_rad_s2");
+  p.command_timeout_stop = r.choice("protection.command_timeout_stop", "ss1", {"sto", "ss1"});
+  p.emergency_stop_stop = r.choice("protection.emergency_stop_stop", "sto", {"sto", "ss1"});
+  p.encoder_stop = r.choice("protection.encoder_stop", "dc_brake", {"sto", "dc_brake"});
+  p.dc_brake_current_share = r.optional_positive("protection.dc_brake_current_share");
+  if (p.dc_brake_current_share && !(*p.dc_brake_current_share <= 1.0)) {
+    r.fail("protection.dc_brake_current_share",
+           fmt::format("= {}: must be in (0, 1]", *p.dc_brake_current_share));
+  }
 }
 
 }  // namespace imd::sim::detail

@@ -64,8 +64,22 @@ void SimBoard::drift_resistances() noexcept {
                          Rr0_Ohm_ * (1.0 + (d.Rr_scale_end - 1.0) * share));
 }
 
+void SimBoard::update_brake() noexcept {
+  const HoldingBrake& b = config_.brake;
+  const bool released = gpio_.read(HoldingBrake::kLine);
+  const double now_s = plant_.time_s();
+  if (released != brake_line_released_) {
+    brake_line_released_ = released;
+    brake_line_since_s_ = now_s;
+  }
+  const double delay_s = released ? b.release_delay_s : b.engage_delay_s;
+  if (now_s - brake_line_since_s_ >= delay_s - 1e-12) brake_engaged_ = !released;
+  plant_.set_brake_torque(brake_engaged_ ? b.holding_torque_Nm : 0.0);
+}
+
 void SimBoard::end_period() {
   if (config_.drift.active()) drift_resistances();
+  update_brake();
   const double load_now_Nm = load_Nm();
   // What the firmware wrote this tick acts now (no latency) or from the next tick.
   const Vec2 written_analog(analog_.v_A_V(), analog_.v_B_V());

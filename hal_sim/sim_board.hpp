@@ -42,6 +42,15 @@ struct ResistanceDrift {
   }
 };
 
+/// A spring-applied holding brake on the shaft, released while the drive drives its line
+/// (firmware DriveConfig::brake_output_line). Its armature follows the line after a delay.
+struct HoldingBrake {
+  static constexpr int kLine = 3;  ///< the board's GPIO line that releases it
+  double holding_torque_Nm = 0.0;  ///< 0: no brake fitted
+  double engage_delay_s = 0.03;    ///< line dropped -> torque on
+  double release_delay_s = 0.05;   ///< line driven -> torque off
+};
+
 struct SimBoardConfig {
   double period_s = 1e-4;
   int substeps = 10;          ///< RK4 steps per period
@@ -57,6 +66,7 @@ struct SimBoardConfig {
   AdcModelConfig adc;
   uint64_t seed = 1;
   ResistanceDrift drift;
+  HoldingBrake brake;
 };
 
 class SimBoard {
@@ -112,11 +122,15 @@ class SimBoard {
   double v_bus_V() const noexcept { return v_bus_V_; }
   bool encoder_frozen() const noexcept { return encoder_frozen_; }
   bool adc_stuck() const noexcept { return adc_stuck_; }
+  /// The holding brake's torque acts on the shaft (after its delays).
+  bool brake_engaged() const noexcept { return brake_engaged_; }
 
  private:
   void latch_sensors();
   /// The plant's resistances for the period that starts now (ResistanceDrift).
   void drift_resistances() noexcept;
+  /// The brake's armature over the period that starts now, from its line and delays.
+  void update_brake() noexcept;
 
   SimBoardConfig config_;
   InductionMotorPlant plant_;
@@ -138,6 +152,9 @@ class SimBoard {
   Vec2 start_flux_s_alphabeta_Wb_ = Vec2::Zero();
   Vec2 start_current_alphabeta_A_ = Vec2::Zero();
   Vec2 applied_voltage_V_ = Vec2::Zero();
+  bool brake_engaged_ = true;  ///< spring-applied: engaged until the line releases it
+  double brake_line_since_s_ = 0.0;  ///< the line's level has held since
+  bool brake_line_released_ = false;
   double v_bus_V_;
   bool encoder_frozen_ = false;
   bool adc_stuck_ = false;

@@ -110,7 +110,7 @@ Trip Protection<T>::check(const Measurement<T>& m, const Estimate<T>& e, const S
     trip.add(FaultCode::adc_offset, m.offset_fault_phase);
   }
   if (!m.valid) return trip;  // nothing measured: calibrating, or offsets unknown
-  check_sensed(m, e, s.modulating, motor, trip);
+  check_sensed(m, e, s.modulating && !s.brake_may_hold, s.dc_braking ? nullptr : motor, trip);
   if (!s.modulating || motor == nullptr || trip.any()) {
     if (motor != nullptr) motor->idle();
     return trip;
@@ -162,7 +162,7 @@ inline void Protection<T>::check_driving(const Measurement<T>& m, const Estimate
   if (config_.check_adc_stuck && motor.adc_stuck.stuck(m.phase_code, u_last_V)) {
     trip.add(FaultCode::adc_stuck);
   }
-  if (e.current_predicted) {
+  if (e.current_predicted && !s.dc_braking) {
     const control::PhaseValues<T> predicted = control::inverse_clarke(e.i_predicted_alphabeta_A);
     const T i_predicted_abc_A[3] = {predicted[0], predicted[1], predicted[2]};
     const int lost = motor.phase_loss.lost_phase(i_predicted_abc_A, m.i_abc_A, m.v_bus_V);

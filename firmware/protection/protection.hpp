@@ -36,6 +36,12 @@ struct SupervisedState {
   bool enable_input = true;  ///< the board's enable input (true without one)
   bool restarted = false;    ///< enabled or cleared this tick: the checks start afresh
   bool magnetizing = false;
+  /// A fault's DC braking: the estimates have no position to rest on (the encoder failed), so
+  /// the checks that use them (encoder, phase loss) do not judge.
+  bool dc_braking = false;
+  /// The holding brake may still hold the rotor (engaged, or released less than its release
+  /// time ago): the load is unbounded, so the encoder check judges only jumps.
+  bool brake_may_hold = false;
   bool watchdog_armed = false;         ///< CAN-commanded and magnetizing or running
   uint32_t magnetizing_ticks = 0;      ///< since magnetizing began (saturates)
   uint32_t command_silence_ticks = 0;  ///< since the last valid command (saturates)

@@ -5,6 +5,8 @@
 #include <cstdint>
 #include <limits>
 
+#include "firmware/protection/stop_category.hpp"
+
 namespace imd::firmware {
 
 struct ProtectionConfig {
@@ -38,6 +40,10 @@ struct ProtectionConfig {
   /// Command watchdog while magnetizing or running on CAN commands; 0 disables it.
   double command_timeout_s = 0.2;
   uint32_t tick_budget_ns = 90'000;  ///< execution-time budget; 0: not checked
+  /// How the faults that may choose stop (firmware/protection/stop_category.hpp).
+  StopPolicy stop;
+  /// DC braking: its current, a share of the current limit (docs/safety.md).
+  double dc_brake_current_share = 1.0;
 };
 
 }  // namespace imd::firmware

@@ -103,6 +103,8 @@ inline constexpr ValueName kFaultValues[] = {
     {15, "enable_input"},
 };
 inline constexpr ValueName kControllerValues[] = {{0, "dsmc"}, {1, "iol"}, {2, "ifoc"}};
+inline constexpr ValueName kStopValues[] = {
+    {0, "none"}, {1, "sto"}, {2, "ss1"}, {3, "dc_brake"}};
 inline constexpr ValueName kLimitedValues[] = {
     {0, "none"}, {1, "voltage"}, {2, "current"}, {3, "torque"}};
 inline constexpr ValueName kCommandResultValues[] = {
@@ -148,7 +150,7 @@ inline constexpr Signal kE2eCounter{
 
 // --- signals, one array per message. Signal order is the telemetry's field order.
 inline constexpr Signal kHeartbeatSignals[] = {
-    {"state", 0, 8, false, 1, 1, 0.0f, "", "drive state", kStateValues},
+    {"state", 0, 4, false, 1, 1, 0.0f, "", "drive state", kStateValues},
     {"fault_bits", 8, 16, false, 1, 1, 0.0f, "", "latched faults, bit n = fault code n"},
     {"first_fault", 24, 8, false, 1, 1, 0.0f, "", "first latched fault", kFaultValues},
     {"counter", 32, 8, false, 1, 1, 0.0f, "", "heartbeat count, wraps"},
@@ -161,6 +163,10 @@ inline constexpr Signal kHeartbeatSignals[] = {
      "the limit that holds the running drive from its reference (firmware/limitation.hpp)",
      kLimitedValues},
     {"transitions", 56, 8, false, 1, 1, 0.0f, "", "state transitions, wraps"},
+    {"stop", 4, 2, false, 1, 1, 0.0f, "",
+     "the stop category of the latched fault (firmware/protection/stop_category.hpp)",
+     kStopValues},
+    {"brake", 47, 1, false, 1, 1, 0.0f, "", "the holding brake is engaged (its line not driven)"},
 };
 inline constexpr Signal kFaultReportSignals[] = {
     {"first_fault", 0, 8, false, 1, 1, 0.0f, "", "first latched fault", kFaultValues},

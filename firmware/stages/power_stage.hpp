@@ -23,6 +23,9 @@ struct Modulation {
   control::Vec2<T> u_acting_alphabeta_V = control::Vec2<T>::Zero();
   hal::PhaseDuties duty{0.5f, 0.5f, 0.5f};
   bool clipped = false;  ///< the request exceeded the linear range and was scaled down
+  /// The duties were computed outside the power stage (the commissioning, DC braking) and are
+  /// written as they are.
+  bool direct = false;
   bool finite = true;    ///< false: a NaN or Inf on the way to the power stage
 };
 

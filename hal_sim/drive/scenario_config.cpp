@@ -21,6 +21,7 @@ SimBoardConfig board_config(const Scenario& s) {
   c.adc = s.adc;
   c.seed = s.seed;
   c.drift = {s.Rs_scale_end, s.Rr_scale_end, s.duration_s};
+  c.brake = s.brake;
   c.switching_inverter = s.switching_inverter;
   return c;
 }
@@ -82,6 +83,17 @@ firmware::DriveConfig drive_config(const Scenario& s) {
   p.adc_noise_codes =
       set.adc_noise_codes.value_or(std::max(p.adc_noise_codes, s.adc.noise_A / A_per_code));
   p.command_timeout_s = set.command_timeout_s.value_or(p.command_timeout_s);
+  const auto stop = [](const std::string& name) {
+    using firmware::StopCategory;
+    return name == "ss1" ? StopCategory::ss1
+                         : (name == "dc_brake" ? StopCategory::dc_brake : StopCategory::sto);
+  };
+  p.stop = {stop(set.command_timeout_stop), stop(set.emergency_stop_stop), stop(set.encoder_stop)};
+  p.dc_brake_current_share = set.dc_brake_current_share.value_or(p.dc_brake_current_share);
+  if (s.brake.holding_torque_Nm > 0.0) {  // a brake fitted: its line and its release time
+    c.brake_output_line = sim::HoldingBrake::kLine;
+    c.brake_release_time_s = s.brake.release_delay_s;
+  }
   // Lock-step simulation: the host's wall-clock time per tick is not the MCU's, so the budget
   // is checked only when the scenario sets one.
   p.tick_budget_ns = static_cast<uint32_t>(std::lround(set.tick_budget_us.value_or(0.0) * 1e3));

@@ -33,7 +33,7 @@ Summary run(const Scenario& s, const RunCallbacks& callbacks) {
       s.commissioning ? std::nullopt : std::optional<firmware::MotorRecord>(s.motor);
   SimulatedDrive<T> simulated(board, record, config,
                               {s.ideal_sensors, s.inner_feedback, s.current_fed}, &references,
-                              board.timer(), &board.can());
+                              board.timer(), &board.can(), &board.gpio());
   firmware::Drive<T>& drive = simulated.drive();
   const std::vector<ScriptedFrame> commands = scripted_frames(s);
   std::size_t next_command = 0;
@@ -101,7 +101,10 @@ Summary run(const Scenario& s, const RunCallbacks& callbacks) {
       }
       summary.faults[event].code = firmware::fault_name(firmware::FaultCode(code));
       summary.faults[event].detected_at_s = t_s;
-      if (code == int(rec.fault)) summary.faults[event].detail = drive.status().fault_detail;
+      if (code == int(rec.fault)) {
+        summary.faults[event].detail = drive.status().fault_detail;
+        summary.faults[event].stop = firmware::stop_name(rec.stop);
+      }
       awaiting_pwm_off.push_back(event);
     }
     last_fault_bits = rec.fault_bits;

@@ -24,6 +24,8 @@ struct FaultEvent {
   double injected_at_s = std::nan("");
   double detected_at_s = 0.0;
   double pwm_off_at_s = std::nan("");
+  /// The stop the first fault took: "sto", "ss1", "dc_brake"; empty for a later fault.
+  std::string stop = {};
   /// The detail the drive latched with its first fault (the phase of overcurrent, phase_loss
   /// and adc_offset, else 0); -1 for a later fault.
   int detail = -1;

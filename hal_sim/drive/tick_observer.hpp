@@ -44,6 +44,9 @@ struct SimRow {
   int state = 0;
   bool saturated = false;
   int limited = 0;  ///< the drive's `limited` (firmware::Limitation: 0 none, 1 voltage, ...)
+  int stop = 0;     ///< the latched fault's stop (firmware::StopCategory: 0 none, 1 sto, ...)
+  bool brake_line_engaged = true;  ///< the drive's brake line: not driven
+  bool brake_engaged = true;       ///< the board's brake torque acts (after its delays)
 };
 
 /// What the rows and the metrics take from the scenario.
@@ -190,6 +193,9 @@ const SimRow& TickObserver<T>::observe(double t_s, const PlantState& truth, doub
   row.saturated = rec.law.speed_saturated || rec.law.flux_saturated || rec.law.voltage_limited ||
                   rec.voltage_clipped;
   row.limited = static_cast<int>(rec.limited);
+  row.stop = static_cast<int>(rec.stop);
+  row.brake_line_engaged = rec.brake_engaged;
+  row.brake_engaged = board.brake_engaged();
 
   // The ripple of the previous sample, now that its successor is known. For alpha-beta
   // components the mean square over three phases is half of |x|^2.

@@ -28,6 +28,10 @@ struct Case {
   FaultInjection fault;
   const char* code;
   double bound_s;  ///< detection latency bound
+  /// The stop it takes (docs/safety.md, "Stop categories"), and how long the PWM may stay on
+  /// after detection for it: 0 for STO.
+  const char* stop = "sto";
+  double stop_bound_s = 0.0;
 };
 
 /// Runs the scenario with one fault and checks the event; returns the detection latency.
@@ -55,7 +59,13 @@ double run_case(Scenario s, const Case& c) {
   const double latency_s = f.detected_at_s - f.injected_at_s;
   EXPECT_GE(latency_s, 0.0);
   EXPECT_LE(latency_s, c.bound_s + 1e-9) << c.code;
-  EXPECT_EQ(f.pwm_off_at_s, f.detected_at_s) << "the PWM must go off in the detecting tick";
+  EXPECT_EQ(f.stop, c.stop) << c.code;
+  if (c.stop_bound_s == 0.0) {
+    EXPECT_EQ(f.pwm_off_at_s, f.detected_at_s) << "the PWM must go off in the detecting tick";
+  } else {  // a controlled stop first, time-limited
+    EXPECT_GT(f.pwm_off_at_s, f.detected_at_s) << c.code;
+    EXPECT_LE(f.pwm_off_at_s - f.detected_at_s, c.stop_bound_s + 1e-9) << c.code;
+  }
   EXPECT_FALSE(left_fault_state) << "latched until cleared";
   std::printf(
       "fault matrix: %-12s -> %-16s injected %.4f s, detected %.4f s (+%.1f ms), PWM off "
@@ -95,8 +105,11 @@ TEST(FaultMatrix, Undervoltage) {
 }
 
 TEST(FaultMatrix, EncoderLoss) {
+  // At 100 rad/s: DC braking at the current limit, for the time the braking torque takes to
+  // stop the rotor from there without load plus three rotor time constants
+  // (firmware/stages/dc_brake.hpp): 0.19 + 0.12 s.
   run_case(base("seed000_realistic.toml"),
-           {at(kInject_s, FaultKind::encoder_loss), "encoder", 0.01});
+           {at(kInject_s, FaultKind::encoder_loss), "encoder", 0.01, "dc_brake", 0.32});
 }
 
 TEST(FaultMatrix, EncoderLossAtLowSpeed) {
@@ -127,6 +140,7 @@ TEST(FaultMatrix, EncoderLossAtLowSpeed) {
   }
   std::printf("encoder loss at low speed: bound %.1f ms (L_max %.2f N m of %.2f)\n", t * 1e3,
               l_max, t_cap);
+  // Detected at low speed: nothing to brake by DC injection, STO.
   run_case(s, {at(2.0, FaultKind::encoder_loss), "encoder", t + kTick_s});
 }
 
@@ -158,10 +172,13 @@ TEST(FaultMatrix, Overrun) {
 
 TEST(FaultMatrix, CanSilence) {
   // seed000_can.toml repeats set_speed every 50 ms with a 0.2 s watchdog: the trip comes 0.2 s
-  // plus one tick after the last frame, which precedes the silence.
+  // plus one tick after the last frame, which precedes the silence. SS1: the speed ramps from
+  // 50 rad/s at the stop deceleration (200 rad/s^2, 0.25 s), then STO; 0.1 s more for the
+  // speed loop to bring the rotor below the stop speed.
   Scenario s = base("seed000_can.toml");
   const double timeout_s = *s.protection.command_timeout_s;
-  run_case(s, {at(0.4, FaultKind::can_silence), "command_timeout", timeout_s + kTick_s});
+  run_case(s, {at(0.4, FaultKind::can_silence), "command_timeout", timeout_s + kTick_s, "ss1",
+               50.0 / 200.0 + 0.1});
 }
 
 }  // namespace

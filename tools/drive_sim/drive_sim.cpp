@@ -94,6 +94,8 @@ const Column kColumns[] = {
     IMD_COLUMN(rr_est_Ohm),
     IMD_COLUMN(Rr_plant_Ohm),
     IMD_COLUMN(limited),
+    IMD_COLUMN(stop),
+    IMD_COLUMN(brake_engaged),
 };
 #undef IMD_COLUMN
 

@@ -66,7 +66,9 @@ nlohmann::ordered_json summary_json(const imd::sim::Scenario& s, const imd::sim:
                       {"injected_at_s", time(f.injected_at_s)},
                       {"detected_at_s", time(f.detected_at_s)},
                       {"pwm_off_at_s", time(f.pwm_off_at_s)},
-                      {"detail", f.detail}});
+                      {"detail", f.detail},
+                      {"stop", f.stop.empty() ? nlohmann::ordered_json(nullptr)
+                                              : nlohmann::ordered_json(f.stop)}});
   }
   nlohmann::ordered_json stages;  // host wall-clock time: for comparison, not the MCU's
   for (int i = 0; i < imd::firmware::kStageCount; ++i) {

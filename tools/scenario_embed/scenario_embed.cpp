@@ -25,8 +25,8 @@ using imd::firmware::ControllerKind;
 using imd::firmware::DriveConfig;
 
 // A new field must be written here too: these sizes fail the build until it is.
-static_assert(sizeof(DriveConfig) == 448, "DriveConfig changed: write its new fields below");
-static_assert(sizeof(imd::sim::SimBoardConfig) == 152, "SimBoardConfig changed: write it below");
+static_assert(sizeof(DriveConfig) == 472, "DriveConfig changed: write its new fields below");
+static_assert(sizeof(imd::sim::SimBoardConfig) == 176, "SimBoardConfig changed: write it below");
 static_assert(sizeof(imd::control::MotorParameters) == 64, "MotorParameters changed");
 
 class Writer {
@@ -118,6 +118,9 @@ void write_board(Writer& w, const imd::sim::SimBoardConfig& b) {
   w.number("board.drift.Rr_scale_end", b.drift.Rr_scale_end);
   w.number("board.drift.duration_s", b.drift.duration_s);
   w.boolean("board.switching_inverter", b.switching_inverter);
+  w.number("board.brake.holding_torque_Nm", b.brake.holding_torque_Nm);
+  w.number("board.brake.engage_delay_s", b.brake.engage_delay_s);
+  w.number("board.brake.release_delay_s", b.brake.release_delay_s);
 }
 
 void write_drive(Writer& w, const DriveConfig& c) {
@@ -175,6 +178,14 @@ void write_drive(Writer& w, const DriveConfig& c) {
   w.number("drive.protection.adc_noise_codes", p.adc_noise_codes);
   w.number("drive.protection.command_timeout_s", p.command_timeout_s);
   w.line("drive.protection.tick_budget_ns", fmt::format("{}u", p.tick_budget_ns));
+  const auto stop = [](imd::firmware::StopCategory category) {
+    static const char* const kNames[] = {"none", "sto", "ss1", "dc_brake"};
+    return std::string("firmware::StopCategory::") + kNames[static_cast<int>(category)];
+  };
+  w.line("drive.protection.stop.command_timeout", stop(p.stop.command_timeout));
+  w.line("drive.protection.stop.emergency_stop", stop(p.stop.emergency_stop));
+  w.line("drive.protection.stop.encoder", stop(p.stop.encoder));
+  w.number("drive.protection.dc_brake_current_share", p.dc_brake_current_share);
   w.integer("drive.stage_timing_period_ticks", c.stage_timing_period_ticks);
   w.integer("drive.node_id", c.node_id);
   w.boolean("drive.commands_over_can", c.commands_over_can);
@@ -186,6 +197,8 @@ void write_drive(Writer& w, const DriveConfig& c) {
   w.number("drive.stator_flux2_ref_Wb2", c.stator_flux2_ref_Wb2);
   w.integer("drive.enable_input_line", c.enable_input_line);
   w.integer("drive.fault_output_line", c.fault_output_line);
+  w.integer("drive.brake_output_line", c.brake_output_line);
+  w.number("drive.brake_release_time_s", c.brake_release_time_s);
   w.integer("drive.timing_output_line", c.timing_output_line);
   w.number("drive.stop_decel_rad_s2", c.stop_decel_rad_s2);
   w.number("drive.stop_speed_rad_s", c.stop_speed_rad_s);

@@ -79,7 +79,7 @@ int run(const sim::EmbeddedScenario& s, const DriveConfig& drive_config, int pla
       {mps2::kCoreClock_Hz, static_cast<uint32_t>(s.board.period_s * 1e9 + 0.5), true}, sensors);
   // The realistic board: the drive's own sensing, estimation and SVPWM, no substitutes.
   static sim::SimulatedDrive<float> simulated(board, s.motor, drive_config, {}, &references, timer,
-                                              &board.can());
+                                              &board.can(), &board.gpio());
   Drive<float>& drive = simulated.drive();
   // The same rows and metrics as drive_sim's (hal_sim/drive/tick_observer.hpp).
   static sim::TickObserver<float> observer(
