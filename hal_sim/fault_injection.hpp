@@ -50,6 +50,10 @@ struct FaultInjection {
   int phase = 0;  ///< overcurrent and phase_loss: the phase, 0..2 (a, b, c)
   double bus_V = std::numeric_limits<double>::quiet_NaN();  ///< over/undervoltage: the new bus
   double stall_us = 1000.0;                                 ///< overrun: time stolen per tick
+  /// The fault is repaired at this time (after at_s): the bus back to nominal, the encoder
+  /// counting again from where it froze, the ADC converting, the phase closed, the stall and
+  /// the silence over. An over-current surge is over at once. Infinite: never.
+  double until_s = std::numeric_limits<double>::infinity();
 };
 
 /// Why SimBoard::inject would refuse this fault: a static message naming the kind and the

@@ -48,10 +48,14 @@ FaultInjection read_fault(Reader& r, const std::string& base, const toml::table&
   FaultInjection fault;
   fault.at_s = r.non_negative(key("at_s"), std::nullopt);
   fault.kind = read_fault_kind(r, key("kind"));
+  fault.until_s = r.number(key("until_s"), fault.until_s);
+  if (!(fault.until_s > fault.at_s)) {
+    r.fail(key("until_s"), fmt::format("= {}: must be after at_s ({})", fault.until_s, fault.at_s));
+  }
   const char* kind_name = fault_kind_name(fault.kind);
 
   for (const auto& [name, node] : table) {
-    if (name == "at_s" || name == "kind") continue;
+    if (name == "at_s" || name == "kind" || name == "until_s") continue;
     const std::string_view key_name = name.str();  // clang 14 cannot capture a structured binding
     const auto known = std::find_if(kFaultKeys.begin(), kFaultKeys.end(),
                                     [&](const FaultKey& k) { return k.name == key_name; });

@@ -44,7 +44,9 @@ void SimBoard::latch_sensors() {
   const PlantState& s = plant_.state();
   const auto i_abc = control::inverse_clarke(s.i_s_alphabeta_A);
   if (!adc_stuck_) adc_.latch(adc_model_.convert({i_abc[0], i_abc[1], i_abc[2]}, v_bus_V_));
-  if (!encoder_frozen_) encoder_.latch(encoder_count(s.theta_mech_rad, config_.encoder_cpr));
+  if (!encoder_frozen_) {
+    encoder_.latch(encoder_count(s.theta_mech_rad, config_.encoder_cpr) + encoder_offset_counts_);
+  }
 }
 
 void SimBoard::run_tick() {
@@ -164,6 +166,35 @@ bool SimBoard::inject(const FaultInjection& fault) noexcept {
   }
   ++injected_count_;
   return true;
+}
+
+void SimBoard::repair(const FaultInjection& fault) noexcept {
+  switch (fault.kind) {
+    case FaultKind::overcurrent:  // a surge: over at once
+      break;
+    case FaultKind::overvoltage:
+    case FaultKind::undervoltage:
+      v_bus_V_ = config_.v_bus_V;
+      break;
+    case FaultKind::encoder_loss:
+      // An incremental encoder counts on from where it stopped: the motion meanwhile is lost.
+      encoder_offset_counts_ =
+          encoder_.count() - encoder_count(plant_.state().theta_mech_rad, config_.encoder_cpr);
+      encoder_frozen_ = false;
+      break;
+    case FaultKind::adc_stuck:
+      adc_stuck_ = false;
+      break;
+    case FaultKind::phase_loss:
+      plant_.set_open_phases(plant_.open_phases() & ~(1u << fault.phase));
+      break;
+    case FaultKind::overrun:
+      timer_.set_stall_ns(0);
+      break;
+    case FaultKind::can_silence:
+      can_.unsilence();
+      break;
+  }
 }
 
 }  // namespace imd::sim

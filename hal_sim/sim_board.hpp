@@ -116,6 +116,8 @@ class SimBoard {
   /// between ticks: the next run_tick() sees it. Returns false and changes nothing when a
   /// parameter is out of its range (fault_parameter_error says which).
   [[nodiscard]] bool inject(const FaultInjection& fault) noexcept;
+  /// Repairs a fault inject() applied (FaultInjection::until_s says how). Call between ticks.
+  void repair(const FaultInjection& fault) noexcept;
   /// How many faults inject() has applied.
   std::size_t injected_count() const noexcept { return injected_count_; }
   /// The DC bus now: config().v_bus_V until a bus fault changes it.
@@ -153,6 +155,7 @@ class SimBoard {
   Vec2 start_current_alphabeta_A_ = Vec2::Zero();
   Vec2 applied_voltage_V_ = Vec2::Zero();
   bool brake_engaged_ = true;  ///< spring-applied: engaged until the line releases it
+  uint32_t encoder_offset_counts_ = 0;  ///< counts lost while the encoder was frozen
   double brake_line_since_s_ = 0.0;  ///< the line's level has held since
   bool brake_line_released_ = false;
   double v_bus_V_;

@@ -100,6 +100,7 @@ class SimCan final : public hal::CanBus {
   /// Fault: from now on every injected frame is lost (the host side falls silent). Frames
   /// already received stay; the firmware's sent frames are still collected.
   void silence() noexcept { silenced_ = true; }
+  void unsilence() noexcept { silenced_ = false; }
   bool silenced() const noexcept { return silenced_; }
   /// Frames lost to the silence so far.
   uint64_t dropped_frames() const noexcept { return dropped_; }
