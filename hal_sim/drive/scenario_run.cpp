@@ -67,6 +67,7 @@ Summary run(const Scenario& s, const RunCallbacks& callbacks) {
       summary.faults.push_back(
           {"none", fault_kind_name(fault.kind), t_s, std::nan(""), std::nan("")});
     });
+    if (callbacks.host) callbacks.host(k, t_s, board, drive.status());
     const PlantState& truth = board.plant().state();
     if (!truth.flux_r_alphabeta_Wb.allFinite() || !truth.i_s_alphabeta_A.allFinite() ||
         !std::isfinite(truth.omega_mech_rad_s) || !std::isfinite(truth.theta_mech_rad)) {

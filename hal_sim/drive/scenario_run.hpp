@@ -9,6 +9,7 @@
 #include <utility>
 #include <vector>
 
+#include "firmware/telemetry.hpp"
 #include "hal/can_bus.hpp"
 #include "hal_sim/drive/commissioning_watch.hpp"
 #include "hal_sim/drive/tick_observer.hpp"
@@ -77,12 +78,19 @@ struct RunCallbacks {
   using Row = std::function<void(const SimRow&)>;
   using Progress = std::function<void(double simulated_s, double wall_s)>;
   using Frame = std::function<void(double t_s, const hal::CanFrame&)>;
-  RunCallbacks(Row row_ = {}, Progress progress_ = {}, Frame can_frame_ = {})
-      : row(std::move(row_)), progress(std::move(progress_)), can_frame(std::move(can_frame_)) {}
+  /// A host acting on the board between ticks (frames, faults, load), seeing the drive's status.
+  using Host = std::function<void(uint64_t k, double t_s, SimBoard& board,
+                                  const firmware::DriveStatus& status)>;
+  RunCallbacks(Row row_ = {}, Progress progress_ = {}, Frame can_frame_ = {}, Host host_ = {})
+      : row(std::move(row_)),
+        progress(std::move(progress_)),
+        can_frame(std::move(can_frame_)),
+        host(std::move(host_)) {}
 
   Row row;            ///< every tick, if set
   Progress progress;  ///< about once per wall-clock second: simulated time so far
   Frame can_frame;    ///< every frame the firmware sent, with the time of the tick that sent it
+  Host host;          ///< before every tick, after the scenario's own frames and faults
 };
 
 /// Throws std::invalid_argument on a fault SimBoard refuses (fault_parameter_error), which

@@ -18,8 +18,8 @@
 #include "firmware/drive_state.hpp"
 #include "firmware/protection/stop_category.hpp"
 #include "hal_sim/drive/scenario_run.hpp"
+#include "hal_sim/law_variant.hpp"
 #include "hal_sim/scenario.hpp"
-#include "law_variant.hpp"
 #include "test_motors.hpp"
 
 namespace imd::sim {
@@ -69,7 +69,7 @@ void commands(Scenario& s, double from_s) {
 }
 
 Scenario matrix_case(const std::string& law, const std::string& precision, const Kind& k) {
-  Scenario s = test::with_law(
+  Scenario s = with_law(
       load_scenario(test::source_path("hal_sim/scenarios/seed000_can.toml")), law);
   s.precision = precision;
   s.can_commands.clear();
@@ -80,7 +80,7 @@ Scenario matrix_case(const std::string& law, const std::string& precision, const
   clear.message = "clear_faults";
   s.can_commands.push_back(clear);
   commands(s, kRestart_s + 0.05);
-  s.load = test::load_steps({{0.0, 0.5}});
+  s.load = load_steps({{0.0, 0.5}});
   s.brake.holding_torque_Nm = 5.0;
   s.protection.tick_budget_us = 100'000.0;  // host time per tick is not the MCU's: a loose one
   s.duration_s = kRestart_s + 0.95;

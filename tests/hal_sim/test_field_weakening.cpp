@@ -11,8 +11,8 @@
 #include <vector>
 
 #include "hal_sim/drive/scenario_run.hpp"
+#include "hal_sim/law_variant.hpp"
 #include "hal_sim/scenario.hpp"
-#include "law_variant.hpp"
 #include "test_motors.hpp"
 
 namespace imd::sim {
@@ -40,16 +40,16 @@ struct Outcome {
 
 Outcome run(const Case& c, const std::string& law) {
   const Scenario base = load_scenario(test::source_path(c.file));
-  const double omega_ref = 2.0 * test::base_speed_rad_s(base, c.flux2_Wb2);
+  const double omega_ref = 2.0 * base_speed_rad_s(base, c.flux2_Wb2);
   // The reference ramps up in 3 s, then 3 s are left to get there.
-  Scenario s = test::with_law(
+  Scenario s = with_law(
       load_scenario(test::source_path(c.file),
                     {"drive.max_accel_rad_s2=" + std::to_string(omega_ref / 3.0),
                      "protection.overspeed_rad_s=" + std::to_string(1.5 * omega_ref),
                      "simulation.duration_s=6.0", "metrics.settle_s=5.0"}),
       law);
   // A step at t = 0 and no load.
-  s.speed = test::speed_steps({{0.0, omega_ref}});
+  s.speed = speed_steps({{0.0, omega_ref}});
   s.load = LoadProfile{};
   Outcome out;
   out.omega_ref_rad_s = omega_ref;

@@ -11,8 +11,8 @@
 #include <vector>
 
 #include "hal_sim/drive/scenario_run.hpp"
+#include "hal_sim/law_variant.hpp"
 #include "hal_sim/scenario.hpp"
-#include "law_variant.hpp"
 #include "test_motors.hpp"
 
 namespace imd::sim {
@@ -40,7 +40,7 @@ TEST(PhaseLossSweep, AnOpenPhaseIsFoundAtAnyTimeWithEveryLaw) {
   for (const char* law : kLaws) {
     double worst_s = 0.0;
     for (int i = 0; i < 30; ++i) {
-      Scenario s = test::with_law(board, law);
+      Scenario s = with_law(board, law);
       FaultInjection f;
       f.at_s = 0.6 + 3.4 * i / 29.0;
       f.kind = FaultKind::phase_loss;
@@ -78,13 +78,13 @@ TEST(PhaseLossSweep, NoFalseTripOnAHealthyMotor) {
     for (const char* law : kLaws) {
       for (const double flux_share : {1.0, 0.6}) {
         for (const int seed : {1, 2}) {
-          Scenario s = test::with_law(
+          Scenario s = with_law(
               load_scenario(test::source_path(file), {"simulation.seed=" + std::to_string(seed)}),
               law, flux_share);
-          const double w = test::base_speed_rad_s(s, s.flux2_Wb2);
-          const double t = test::torque_at_current_limit_Nm(s, s.flux2_Wb2);
-          s.speed = test::speed_steps({{0.5, 0.4 * w}, {2.0, -0.3 * w}, {3.0, 0.0}});
-          s.load = test::load_steps({{1.2, 0.5 * t}, {2.0, 0.25 * t}, {3.0, 0.3 * t}});
+          const double w = base_speed_rad_s(s, s.flux2_Wb2);
+          const double t = torque_at_current_limit_Nm(s, s.flux2_Wb2);
+          s.speed = speed_steps({{0.5, 0.4 * w}, {2.0, -0.3 * w}, {3.0, 0.0}});
+          s.load = load_steps({{1.2, 0.5 * t}, {2.0, 0.25 * t}, {3.0, 0.3 * t}});
           s.max_accel_rad_s2 = w / 0.3;  // each step ramps in 0.3 s (of base speed)
           s.duration_s = 4.0;
           s.settle_s = 3.5;

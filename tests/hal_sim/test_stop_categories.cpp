@@ -12,8 +12,8 @@
 #include "firmware/drive_state.hpp"
 #include "firmware/protection/stop_category.hpp"
 #include "hal_sim/drive/scenario_run.hpp"
+#include "hal_sim/law_variant.hpp"
 #include "hal_sim/scenario.hpp"
-#include "law_variant.hpp"
 #include "test_motors.hpp"
 
 namespace imd::sim {
@@ -63,10 +63,10 @@ StopTrace run(const Scenario& s) {
 /// The seed-000 realistic board at a constant speed under a constant load, a holding brake of
 /// `brake_Nm` fitted.
 Scenario board(double speed_rad_s, double load_Nm, double brake_Nm, double duration_s) {
-  Scenario s = test::with_law(
+  Scenario s = with_law(
       load_scenario(test::source_path("hal_sim/scenarios/seed000_realistic.toml")), "dsmc");
-  s.speed = test::speed_steps({{0.0, speed_rad_s}});
-  s.load = test::load_steps({{0.0, load_Nm}});
+  s.speed = speed_steps({{0.0, speed_rad_s}});
+  s.load = load_steps({{0.0, load_Nm}});
   s.max_accel_rad_s2 = 200.0;
   s.brake.holding_torque_Nm = brake_Nm;
   s.duration_s = duration_s;

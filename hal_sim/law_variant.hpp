@@ -1,8 +1,8 @@
 #pragma once
-// A scenario written for the rotor-flux laws (a rotor-flux reference, a speed profile) run with
-// any of the drive's laws, so that a test can take every law through the same motor, board and
-// profile. The torque limit and the IOL's references and loops follow from the motor and the
-// board, as a user would set them.
+/// A scenario written for the rotor-flux laws (a rotor-flux reference, a speed profile) run
+/// with any of the drive's laws, so that the tests and the soak can take every law through the
+/// same motor, board and profile. The torque limit and the IOL's references and loops follow
+/// from the motor and the board, as a user would set them.
 #include <algorithm>
 #include <cmath>
 #include <initializer_list>
@@ -12,12 +12,12 @@
 #include "control/ifoc_design.hpp"
 #include "hal_sim/scenario.hpp"
 
-namespace imd::test {
+namespace imd::sim {
 
 /// Mechanical base speed: where the no-load stator voltage at the flux reference,
 /// i_d sqrt(Rs^2 + (w_e Ls)^2) with i_d = psi / Lm, reaches what SVPWM gives with the drive's
 /// 0.95 modulation margin, 0.95 v_bus / sqrt(3).
-inline double base_speed_rad_s(const sim::Scenario& s, double flux2_Wb2) {
+inline double base_speed_rad_s(const Scenario& s, double flux2_Wb2) {
   const control::MotorParameters& m = s.motor;
   const double v_max = 0.95 * s.v_bus_V / std::sqrt(3.0);
   const double i_d = std::sqrt(flux2_Wb2) / m.Lm_H;
@@ -25,9 +25,9 @@ inline double base_speed_rad_s(const sim::Scenario& s, double flux2_Wb2) {
 }
 
 /// A speed reference of steps {time, value}, 0 before the first.
-inline sim::SpeedProfile speed_steps(std::initializer_list<std::pair<double, double>> steps) {
-  sim::SpeedProfile p;
-  p.kind = sim::SpeedProfile::Kind::steps;
+inline SpeedProfile speed_steps(std::initializer_list<std::pair<double, double>> steps) {
+  SpeedProfile p;
+  p.kind = SpeedProfile::Kind::steps;
   for (const auto& [t_s, value] : steps) {
     p.times_s[p.step_count] = t_s;
     p.values_rad_s[p.step_count++] = value;
@@ -36,9 +36,9 @@ inline sim::SpeedProfile speed_steps(std::initializer_list<std::pair<double, dou
 }
 
 /// A load of steps {time, value}, 0 before the first.
-inline sim::LoadProfile load_steps(std::initializer_list<std::pair<double, double>> steps) {
-  sim::LoadProfile p;
-  p.kind = sim::LoadProfile::Kind::steps;
+inline LoadProfile load_steps(std::initializer_list<std::pair<double, double>> steps) {
+  LoadProfile p;
+  p.kind = LoadProfile::Kind::steps;
   for (const auto& [t_s, value] : steps) {
     p.times_s[p.step_count] = t_s;
     p.values_Nm[p.step_count++] = value;
@@ -48,7 +48,7 @@ inline sim::LoadProfile load_steps(std::initializer_list<std::pair<double, doubl
 
 /// The torque the current limit allows at a rotor flux (3/2 p Lm/Lr psi i_q, with |i| at the
 /// drive's 0.95 current margin and i_d = psi / Lm): what the speed loops may ask for.
-inline double torque_at_current_limit_Nm(const sim::Scenario& s, double flux2_Wb2) {
+inline double torque_at_current_limit_Nm(const Scenario& s, double flux2_Wb2) {
   const control::MotorParameters& m = s.motor;
   const double flux = std::sqrt(flux2_Wb2), i_max = 0.95 * s.i_max_A;
   const double i_q = std::sqrt(std::max(i_max * i_max - std::pow(flux / m.Lm_H, 2), 0.0));
@@ -60,7 +60,7 @@ inline double torque_at_current_limit_Nm(const sim::Scenario& s, double flux2_Wb
 /// load, (Ls/Lm)^2 psi_r^2, and its outer loops: the speed loop at the IFOC's speed bandwidth
 /// (control/ifoc_design.hpp), the flux loop at 20 ms (above the 2 IOL periods it needs,
 /// docs/iol.md).
-inline sim::Scenario with_law(sim::Scenario s, const std::string& law, double flux_share = 1.0) {
+inline Scenario with_law(Scenario s, const std::string& law, double flux_share = 1.0) {
   const control::MotorParameters& m = s.motor;
   // A file written for the IOL gives its stator flux: the rotor flux of the same at no load.
   if (s.controller == "iol") s.flux2_Wb2 = std::pow(m.Lm_H / m.Ls_H, 2) * s.stator_flux2_Wb2;
@@ -77,4 +77,4 @@ inline sim::Scenario with_law(sim::Scenario s, const std::string& law, double fl
   return s;
 }
 
-}  // namespace imd::test
+}  // namespace imd::sim
