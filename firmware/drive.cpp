@@ -49,6 +49,7 @@ Drive<T>::Drive(const std::optional<MotorRecord>& record, const DriveConfig& con
       brake_release_ticks_(duration_ticks(config.brake_release_time_s, config.sample_period_s)) {
   protection_.set_clock(clock_Hz_);
   hw_.pwm.disable();
+  supervisor_.status().reset_cause = static_cast<uint8_t>(peripherals.reset_cause);
 }
 
 template <typename T>
@@ -79,6 +80,7 @@ void Drive<T>::on_tick() noexcept {
   clock.lap(Stage::protect);
   actuate(k, e, out, trip, model);
   check_budget(k, clock.lap_total(Stage::actuate), model);
+  if (hw_.watchdog != nullptr) hw_.watchdog->feed();  // the PWM is written: the tick lives
   publish(k, m, e, plan, u, out, model);
   end_identification(k);
   if (bank_.apply_wanted()) release_model();

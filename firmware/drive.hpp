@@ -40,6 +40,7 @@
 #include "hal/gpio.hpp"
 #include "hal/parameter_store.hpp"
 #include "hal/pwm.hpp"
+#include "hal/watchdog.hpp"
 
 namespace imd::firmware {
 
@@ -52,6 +53,8 @@ struct DrivePeripherals {
   hal::CanBus* can = nullptr;  ///< commands and telemetry; without it the drive is local only
   hal::Gpio* gpio = nullptr;   ///< the lines DriveConfig names (enable, fault, timing)
   hal::ParameterStore* store = nullptr;  ///< where a save puts the motor record; none: refused
+  hal::Watchdog* watchdog = nullptr;     ///< fed at the end of every tick; none: not fed
+  hal::ResetCause reset_cause = hal::ResetCause::power_on;  ///< the board's, for the heartbeat
 };
 
 /// Parts that replace the drive's own, each optional (null: the board's part). A reference

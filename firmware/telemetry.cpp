@@ -135,7 +135,7 @@ void Telemetry::send_heartbeat(hal::CanBus& can, const DriveStatus& status,
                           float(status.controller), status.can_bus_off ? 1.0f : 0.0f,
                           float(status.rejected_commands & 0x3F), float(status.limited),
                           float(machine.count() & 0xFF), float(status.stop),
-                          status.brake_engaged ? 1.0f : 0.0f}));
+                          status.brake_engaged ? 1.0f : 0.0f, float(status.reset_cause)}));
 }
 
 void Telemetry::report_fault(hal::CanBus& can, const DriveStatus& status) noexcept {

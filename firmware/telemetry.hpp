@@ -30,6 +30,7 @@ struct DriveStatus {
   Limitation limited = Limitation::none;  ///< a limit holds the running drive back
   StopCategory stop = StopCategory::none;  ///< how the latched fault stops the drive
   bool brake_engaged = true;               ///< the holding brake (engaged unless running)
+  uint8_t reset_cause = 0;                 ///< why the board last started (hal::ResetCause)
   // The last commissioning run: its step (kIdentifyStepValues; 6 none yet), progress and end.
   uint8_t identify_step = 6;
   float identify_fraction = 0.0f;

@@ -103,6 +103,8 @@ inline constexpr ValueName kFaultValues[] = {
     {15, "enable_input"},
 };
 inline constexpr ValueName kControllerValues[] = {{0, "dsmc"}, {1, "iol"}, {2, "ifoc"}};
+inline constexpr ValueName kResetCauseValues[] = {
+    {0, "power_on"}, {1, "watchdog"}, {2, "software"}, {3, "other"}};
 inline constexpr ValueName kStopValues[] = {
     {0, "none"}, {1, "sto"}, {2, "ss1"}, {3, "dc_brake"}};
 inline constexpr ValueName kLimitedValues[] = {
@@ -167,6 +169,8 @@ inline constexpr Signal kHeartbeatSignals[] = {
      "the stop category of the latched fault (firmware/protection/stop_category.hpp)",
      kStopValues},
     {"brake", 47, 1, false, 1, 1, 0.0f, "", "the holding brake is engaged (its line not driven)"},
+    {"reset_cause", 6, 2, false, 1, 1, 0.0f, "", "why the board last started (hal/watchdog.hpp)",
+     kResetCauseValues},
 };
 inline constexpr Signal kFaultReportSignals[] = {
     {"first_fault", 0, 8, false, 1, 1, 0.0f, "", "first latched fault", kFaultValues},

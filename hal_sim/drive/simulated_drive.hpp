@@ -32,17 +32,21 @@ class SimulatedDrive {
   /// config takes them from CAN). `timer`: the board's lock-step timer or a real-time one;
   /// `can`, `gpio`: the board's, a real bus and lines, or none. `store`: a parameter store of
   /// the host's (a file) instead of the board's flash; the drive loads from it, `motor` aside.
+  /// `watchdog`, `reset_cause`: the processor's (the processor-in-the-loop image), or none.
   SimulatedDrive(SimBoard& board, const std::optional<firmware::MotorRecord>& motor,
                  const firmware::DriveConfig& config, const SimulatedParts& parts,
                  const firmware::ReferenceSource<T>* references, hal::ControlTimer& timer,
-                 hal::CanBus* can, hal::Gpio* gpio = nullptr, hal::ParameterStore* store = nullptr)
+                 hal::CanBus* can, hal::Gpio* gpio = nullptr, hal::ParameterStore* store = nullptr,
+                 hal::Watchdog* watchdog = nullptr,
+                 hal::ResetCause reset_cause = hal::ResetCause::power_on)
       : ideal_(board, motor ? motor->motor : board.plant().motor(), config),
         analog_(board),
         current_source_(board),
         flash_store_(flash_),
         store_(store != nullptr ? *store : flash_store_),
         drive_(stored(store == nullptr ? motor : std::nullopt), config,
-               {board.pwm(), board.encoder(), board.adc(), timer, can, gpio, &store_},
+               {board.pwm(), board.encoder(), board.adc(), timer, can, gpio, &store_, watchdog,
+                reset_cause},
                substitutes(parts, references)) {}
 
   firmware::Drive<T>& drive() noexcept { return drive_; }

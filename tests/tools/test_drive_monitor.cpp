@@ -44,14 +44,14 @@ hal::CanFrame voltage(float sample) {
 TEST(drive_monitor_decode, NamesEnumeratedValues) {
   const DecodedFrame d = decode_frame(heartbeat(3.0f, 2.0f), kNode);
   ASSERT_EQ(d.kind, FrameKind::decoded);
-  ASSERT_EQ(d.signal_count, 12u);
+  ASSERT_EQ(d.signal_count, 13u);
   EXPECT_STREQ(d.signals[0].signal->name, "state");
   EXPECT_STREQ(d.signals[0].value_name, "running");
   EXPECT_STREQ(d.signals[2].value_name, "overcurrent");
   EXPECT_EQ(describe(d),
             "heartbeat state=running fault_bits=0 first_fault=overcurrent counter=7 "
             "command_counter=0 controller=iol can_bus_off=0 rejected_commands=2 limited=voltage "
-            "transitions=3 stop=none brake=0");
+            "transitions=3 stop=none brake=0 reset_cause=power_on");
 }
 
 TEST(drive_monitor_decode, SortsOutOtherNodesUnknownIdsAndWrongLengths) {

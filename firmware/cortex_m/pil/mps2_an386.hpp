@@ -6,6 +6,7 @@ namespace imd::firmware::mps2 {
 
 inline constexpr uint32_t kCoreClock_Hz = 25'000'000;  ///< SYSCLK: the core and SysTick
 inline constexpr uintptr_t kUart0 = 0x40004000;        ///< CMSDK APB UART 0 (QEMU: -serial)
+inline constexpr uintptr_t kWatchdog = 0x40008000;     ///< CMSDK APB watchdog, its IRQ the NMI
 inline constexpr uint32_t kUartBaud_Hz = 115'200;
 
 /// CMSDK APB timer 0, free-running down from 2^32 - 1 at the core clock: it times work between

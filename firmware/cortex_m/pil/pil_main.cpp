@@ -9,6 +9,7 @@
 /// the summary goes to the UART and the run ends through semihosting with the exit status:
 ///   0 the run completed with no fault and no overrun, 1 it did not, 2 a bad command line,
 ///   3 a processor fault.
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 
@@ -20,6 +21,8 @@
 #include "hal_sim/drive/lookahead_references.hpp"
 #include "hal/cortex_m/armv7m.hpp"
 #include "hal/cortex_m/cmsdk_uart.hpp"
+#include "hal/cortex_m/cmsdk_watchdog.hpp"
+#include "hal/cortex_m/reset_record.hpp"
 #include "hal/cortex_m/fault_handler.hpp"
 #include "hal/cortex_m/semihosting.hpp"
 #include "hal/cortex_m/two_stage_tick.hpp"
@@ -36,6 +39,11 @@ namespace {
 
 namespace cm = hal::cortex_m;
 
+/// The watchdog's period, in its clock's counts (the core clock's, 25 MHz of virtual time:
+/// QEMU -icount shift=0 runs an instruction per ns). 0.2 s covers the lock-step's plant work
+/// between two ticks (the report gives the largest interval seen) many times over.
+constexpr uint32_t kWatchdogTimeoutCounts = mps2::kCoreClock_Hz / 5;
+
 /// The sample stage: the simulated ADC and encoder latch the plant's state at t_k.
 class SimulatedSensors final : public cm::SampleStage {
  public:
@@ -47,6 +55,27 @@ class SimulatedSensors final : public cm::SampleStage {
 };
 
 cm::CmsdkUart* g_console = nullptr;
+cm::CmsdkWatchdog* g_watchdog = nullptr;
+
+/// The control stage as the timer runs it: the drive's tick, which hangs at `stall_tick` (a
+/// stalled control stage: only the watchdog gets the board out).
+class ControlStage final : public hal::TickHandler {
+ public:
+  ControlStage(Drive<float>& drive, const hal::ControlTimer& timer, uint64_t stall_tick) noexcept
+      : drive_(drive), timer_(timer), stall_tick_(stall_tick) {}
+  void on_tick() noexcept override {
+    if (timer_.tick_count() == stall_tick_) {
+      for (volatile bool hung = true; hung;) {
+      }
+    }
+    drive_.on_tick();
+  }
+
+ private:
+  Drive<float>& drive_;
+  const hal::ControlTimer& timer_;
+  uint64_t stall_tick_;
+};
 
 /// Sleeps until the control stage of this tick has finished. Interrupts are masked around the
 /// test so that the end of the tick cannot slip in between the test and the sleep (WFI still
@@ -68,9 +97,10 @@ control::MotorParameters plant_of(const sim::EmbeddedScenario& s, int rr_percent
   return plant;
 }
 
-int run(const sim::EmbeddedScenario& s, const DriveConfig& drive_config, int plant_rr_percent,
+int run(const sim::EmbeddedScenario& s, const PilOptions& options, hal::ResetCause reset_cause,
         cm::CmsdkUart& console) {
-  static sim::SimBoard board(plant_of(s, plant_rr_percent), s.board);
+  const DriveConfig& drive_config = options.drive;
+  static sim::SimBoard board(plant_of(s, options.plant_rr_percent), s.board);
   board.set_load_profile(s.load);
   board.plant().set_state(s.initial_state);
   static sim::LookaheadReferences<float> references(s.references, s.drive.sample_period_s);
@@ -79,8 +109,15 @@ int run(const sim::EmbeddedScenario& s, const DriveConfig& drive_config, int pla
       {mps2::kCoreClock_Hz, static_cast<uint32_t>(s.board.period_s * 1e9 + 0.5), true}, sensors);
   // The realistic board: the drive's own sensing, estimation and SVPWM, no substitutes.
   static sim::SimulatedDrive<float> simulated(board, s.motor, drive_config, {}, &references, timer,
-                                              &board.can(), &board.gpio());
+                                              &board.can(), &board.gpio(), nullptr, g_watchdog,
+                                              reset_cause);
   Drive<float>& drive = simulated.drive();
+  // After a watchdog reset the run goes on without the stall that caused it.
+  const bool stall = options.stall_at_ms >= 0 && reset_cause != hal::ResetCause::watchdog;
+  static ControlStage control(
+      drive, timer,
+      stall ? static_cast<uint64_t>(double(options.stall_at_ms) * 1e-3 / s.board.period_s + 0.5)
+            : UINT64_MAX);
   // The same rows and metrics as drive_sim's (hal_sim/drive/tick_observer.hpp).
   static sim::TickObserver<float> observer(
       sim::observed_run(s.references, s.settle_s, s.motor, drive_config));
@@ -88,13 +125,17 @@ int run(const sim::EmbeddedScenario& s, const DriveConfig& drive_config, int pla
   static const mps2::FreeRunningTimer service_clock;
   report.start(s, drive_config, timer.counts_per_period());  // with the stack used so far: the start-up's
 
-  const auto ticks = static_cast<uint64_t>(s.duration_s / s.board.period_s + 0.5);
+  const double duration_s =
+      options.duration_ms > 0 ? double(options.duration_ms) * 1e-3 : s.duration_s;
+  const auto ticks = static_cast<uint64_t>(duration_s / s.board.period_s + 0.5);
+  bool heartbeat_seen = false;
+  uint32_t feed_interval_max = 0, last_feed_counts = service_clock.counts();
   uint64_t frames_sent = 0;
   sim::StageTotals stage_totals;
   hal::CanFrame frame;
   references.fill_from(0);
   cm::bind_tick_interrupts(timer);
-  timer.start(drive);
+  timer.start(control);
   for (uint64_t k = 0; k < ticks; ++k) {
     const double t_s = double(k) * s.board.period_s;
     // The tick runs from the timer's interrupts; then time stands still while the plant
@@ -102,18 +143,30 @@ int run(const sim::EmbeddedScenario& s, const DriveConfig& drive_config, int pla
     const sim::SimRow& row = sim::lockstep_period(board, drive, observer, t_s, [&] {
       if (k > 0) timer.resume();
       wait_for_tick(timer);
+      // The watchdog's period must cover the lock-step's plant work between ticks.
+      const uint32_t now = service_clock.counts();
+      feed_interval_max = std::max(feed_interval_max, now - last_feed_counts);
+      last_feed_counts = now;
     });
     const uint32_t retunes = drive.retunes();
     const uint32_t service_start = service_clock.counts();
     drive.service();  // the main loop's out-of-tick work, between ticks
     if (drive.retunes() != retunes) report.retuned(service_clock.counts() - service_start);
     const TickRecord<float>& rec = drive.record();
-    while (board.can_side().take_sent(frame)) ++frames_sent;  // the host side reads the bus
+    while (board.can_side().take_sent(frame)) {  // the host side reads the bus
+      ++frames_sent;
+      if (!heartbeat_seen && frame.id == protocol::can_id(drive_config.node_id,
+                                                          protocol::MessageId::heartbeat)) {
+        heartbeat_seen = true;
+        report.first_heartbeat(frame);
+      }
+    }
     if (rec.stages_timed) stage_totals.add(rec.stage_counts);
     references.fill_from(k + 1);
     if (!std::isfinite(row.i_alpha_A) || !std::isfinite(row.i_beta_A)) break;
   }
   timer.stop();
+  report.watchdog(feed_interval_max, kWatchdogTimeoutCounts);
   report.stages(stage_totals, timer.execution_clock_Hz());
   return report.finish(drive, timer, observer, frames_sent);
 }
@@ -125,6 +178,16 @@ int run(const sim::EmbeddedScenario& s, const DriveConfig& drive_config, int pla
 namespace imd::hal::cortex_m {
 
 void on_fatal_fault(FatalFault fault) noexcept {
+  // The watchdog's first expiry: record why the reset that follows happens, and wait for it.
+  if (fault == FatalFault::nmi && imd::firmware::g_watchdog != nullptr &&
+      imd::firmware::g_watchdog->expired()) {
+    record_reset_cause(imd::hal::ResetCause::watchdog);
+    if (imd::firmware::g_console != nullptr) {
+      imd::firmware::g_console->write("pil watchdog expired: the board resets\n");
+    }
+    for (;;) {
+    }
+  }
   // Nothing drives a power stage here; report and end the emulation.
   if (imd::firmware::g_console != nullptr) {
     imd::firmware::g_console->write("pil fatal_fault ");
@@ -141,6 +204,14 @@ int main() {
   static hal::cortex_m::CmsdkUart console(firmware::mps2::kUart0, firmware::mps2::kCoreClock_Hz,
                                           firmware::mps2::kUartBaud_Hz);
   firmware::g_console = &console;
+  const hal::ResetCause reset_cause = hal::cortex_m::take_reset_cause();
+  console.write("pil reset_cause ");
+  console.write(firmware::protocol::kResetCauseValues[static_cast<int>(reset_cause)].name);
+  console.write("\n");
+  // Fed by the control stage only: a stalled tick ends in its NMI, then a reset.
+  static hal::cortex_m::CmsdkWatchdog watchdog(firmware::mps2::kWatchdog,
+                                               firmware::kWatchdogTimeoutCounts);
+  firmware::g_watchdog = &watchdog;
   static char command_line[128];
   if (!hal::cortex_m::semihosting_command_line(command_line, sizeof command_line)) {
     command_line[0] = '\0';
@@ -157,5 +228,5 @@ int main() {
     hal::cortex_m::semihosting_exit(2);
   }
   hal::cortex_m::semihosting_exit(
-      firmware::run(*options.scenario, options.drive, options.plant_rr_percent, console));
+      firmware::run(*options.scenario, options, reset_cause, console));
 }

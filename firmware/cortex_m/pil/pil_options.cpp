@@ -5,6 +5,19 @@
 #include "firmware/laws/law_registry.hpp"
 
 namespace imd::firmware {
+namespace {
+
+/// A count of milliseconds, 0..10^7; -1 if the word is not one.
+long milliseconds(std::string_view word) noexcept {
+  long value = 0;
+  for (const char c : word) {
+    if (c < '0' || c > '9' || value > 10'000'000) return -1;
+    value = value * 10 + (c - '0');
+  }
+  return word.empty() || value > 10'000'000 ? -1 : value;
+}
+
+}  // namespace
 
 PilOptions parse_pil_options(std::string_view command_line,
                              std::span<const sim::EmbeddedScenario* const> scenarios) noexcept {
@@ -48,6 +61,15 @@ PilOptions parse_pil_options(std::string_view command_line,
         return o;
       }
       o.plant_rr_percent = percent;
+    } else if (word.starts_with("stall_at_ms=") || word.starts_with("duration_ms=")) {
+      const bool stall = word.starts_with("stall_at_ms=");
+      word.remove_prefix(12);
+      const long ms = milliseconds(word);
+      if (ms < 0 || (!stall && ms == 0)) {
+        o.error = "stall_at_ms and duration_ms must be whole milliseconds (duration > 0)";
+        return o;
+      }
+      (stall ? o.stall_at_ms : o.duration_ms) = ms;
     }
   }
   o.drive = o.scenario->drive;

@@ -1,5 +1,6 @@
 #include "firmware/cortex_m/pil/pil_report.hpp"
 
+#include "firmware/protocol/can_signal.hpp"
 #include "firmware/protocol/messages.hpp"
 #include "hal/cortex_m/stack_usage.hpp"
 #include "hal/cortex_m/text_line.hpp"
@@ -16,6 +17,23 @@ void PilReport::start(const sim::EmbeddedScenario& s, const DriveConfig& drive,
   line.scientific(s.duration_s, 4) << " counts_per_period " << uint64_t(counts_per_period)
                                    << " startup_stack_bytes "
                                    << uint64_t(hal::cortex_m::stack_used_bytes()) << "\n";
+  console_.write(line.view());
+}
+
+void PilReport::first_heartbeat(const hal::CanFrame& frame) noexcept {
+  const protocol::Message& m = protocol::message(protocol::MessageId::heartbeat);
+  const int index = protocol::find_signal(m, "reset_cause");
+  const auto raw = protocol::get_raw(frame.data, m.signals[std::size_t(index)]);
+  TextLine line;
+  line << "pil first_heartbeat reset_cause "
+       << protocol::kResetCauseValues[static_cast<std::size_t>(raw) & 3].name << "\n";
+  console_.write(line.view());
+}
+
+void PilReport::watchdog(uint32_t interval_max_counts, uint32_t timeout_counts) noexcept {
+  TextLine line;
+  line << "pil watchdog feed_interval_max_counts " << uint64_t(interval_max_counts)
+       << " timeout_counts " << uint64_t(timeout_counts) << "\n";
   console_.write(line.view());
 }
 

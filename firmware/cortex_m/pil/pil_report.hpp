@@ -29,6 +29,10 @@ class PilReport {
     retune_counts_total_ += counts;
     if (counts > retune_counts_max_) retune_counts_max_ = counts;
   }
+  /// The first heartbeat the drive sent after start-up: its reset cause.
+  void first_heartbeat(const hal::CanFrame& frame) noexcept;
+  /// The largest interval between two control stages, and the watchdog's period (counts).
+  void watchdog(uint32_t interval_max_counts, uint32_t timeout_counts) noexcept;
   /// Prints each stage's mean counts per tick.
   void stages(const sim::StageTotals& totals, uint32_t clock_Hz) noexcept;
   /// Prints the summary; returns the exit status (0: no fault, no overrun, metrics measured).

@@ -19,6 +19,7 @@
 #include "firmware/drive.hpp"
 #include "firmware/parameters/motor_record.hpp"
 #include "hal/cortex_m/stm32g4/flash_pages.hpp"
+#include "hal/cortex_m/stm32g4/iwdg.hpp"
 #include "hal/storage/page_pair_store.hpp"
 #include "hal/cortex_m/armv7m.hpp"
 #include "hal/cortex_m/fault_handler.hpp"
@@ -90,10 +91,14 @@ int main() {
   static hal::PagePairStore<firmware::kMotorRecordBytes> store(flash);
   std::array<uint8_t, firmware::kMotorRecordBytes> record{};
   const std::size_t record_bytes = store.load(record);
+  // The independent watchdog, fed by the control stage only: 2 ms, 20 ticks, well past the
+  // longest tick (its budget is 90 us) plus the main loop's work, which the tick preempts.
+  const hal::ResetCause reset_cause = g4::take_reset_cause();
+  static g4::Iwdg watchdog(kWatchdogTimeout_us);
   // The drive follows its own CAN-commanded references (commands_over_can).
   static firmware::Drive<float> drive(
       firmware::decode_motor_record(std::span<const uint8_t>(record).first(record_bytes)),
-      drive_config(), {pwm, encoder, adc, tick, &can, &gpio, &store});
+      drive_config(), {pwm, encoder, adc, tick, &can, &gpio, &store, &watchdog, reset_cause});
 
   // The carrier (and with it the ADC trigger) starts; the update event must be the peak.
   if (!pwm.start()) halt(BootFailure::pwm_phase);

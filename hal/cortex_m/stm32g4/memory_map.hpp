@@ -17,6 +17,7 @@ inline constexpr uintptr_t kSramBase = 0x2000'0000;
 inline constexpr uintptr_t kTim2 = 0x4000'0000;             // APB1
 inline constexpr uintptr_t kFdcan1 = 0x4000'6400;           // APB1
 inline constexpr uintptr_t kFdcanConfig = 0x4000'6500;      // CKDIV, shared by the FDCANs
+inline constexpr uintptr_t kIwdg = 0x4000'3000;             // APB1
 inline constexpr uintptr_t kPwr = 0x4000'7000;              // APB1
 inline constexpr uintptr_t kFdcanMessageRam = 0x4000'A400;  // SRAMCAN, FDCAN1 first
 inline constexpr uintptr_t kTim1 = 0x4001'2C00;             // APB2
