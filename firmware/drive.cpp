@@ -75,8 +75,10 @@ void Drive<T>::on_tick() noexcept {
       config_.brake_output_line >= 0 &&
       (!brake_line_level_ ||
        k < brake_released_tick_ + brake_release_ticks_);
-  const Trip trip = protection_.check(m, e, supervised, u, out, u_written_V_,
-                                      e.valid ? &model->checks : nullptr);
+  Trip trip = protection_.check(m, e, supervised, u, out, u_written_V_,
+                                e.valid ? &model->checks : nullptr);
+  // The power stage's own over-current trip already turned the outputs off: latch it.
+  if (hw_.pwm.tripped()) trip.add(FaultCode::overcurrent, kHardwareTripDetail);
   clock.lap(Stage::protect);
   actuate(k, e, out, trip, model);
   check_budget(k, clock.lap_total(Stage::actuate), model);

@@ -21,6 +21,9 @@ class Pwm {
   /// All switches off at once (the safe state). Tick context; also from fault handlers.
   virtual void disable() noexcept = 0;
   virtual bool enabled() const noexcept = 0;
+  /// The power stage's own protection (a hardware over-current comparator on the timer's break
+  /// input) turned the outputs off since the last enable, without software. Tick context.
+  virtual bool tripped() const noexcept { return false; }
   /// Carrier period, fixed at configuration.
   virtual float period_s() const noexcept = 0;
 };

@@ -84,6 +84,7 @@ class SimBoard {
   SimCurrentSource& current_source() noexcept { return current_source_; }
   SimCan& can_side() noexcept { return can_; }
   const SimPwm& pwm_side() const noexcept { return pwm_; }
+  SimPwm& pwm_side() noexcept { return pwm_; }
 
   InductionMotorPlant& plant() noexcept { return plant_; }
   const InductionMotorPlant& plant() const noexcept { return plant_; }

@@ -18,15 +18,24 @@ class SimPwm final : public hal::Pwm {
  public:
   explicit SimPwm(float period_s) : period_s_(period_s) {}
   void set_duties(const hal::PhaseDuties& duty) noexcept override { written_ = duty; }
-  void enable() noexcept override { enabled_ = true; }
+  void enable() noexcept override {
+    tripped_ = false;  // as TIM1: the break flag cleared, the outputs on
+    enabled_ = true;
+  }
   void disable() noexcept override { enabled_ = false; }
   bool enabled() const noexcept override { return enabled_; }
+  bool tripped() const noexcept override { return tripped_; }
   float period_s() const noexcept override { return period_s_; }
   const hal::PhaseDuties& written() const noexcept { return written_; }
+  /// The board's over-current comparator on the break input: the outputs off in hardware.
+  void trip() noexcept {
+    enabled_ = false;
+    tripped_ = true;
+  }
 
  private:
   float period_s_;
-  bool enabled_ = false;
+  bool enabled_ = false, tripped_ = false;
   hal::PhaseDuties written_{0.5f, 0.5f, 0.5f};
 };
 

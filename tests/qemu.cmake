@@ -73,3 +73,9 @@ add_test(NAME qemu_pil_mps2_an386_ifoc
                  --scenario ${PROJECT_SOURCE_DIR}/hal_sim/scenarios/seed000_realistic.toml
                  --controller ifoc --work ${CMAKE_BINARY_DIR}/qemu-work-pil-ifoc)
 set_tests_properties(qemu_pil_mps2_an386_ifoc PROPERTIES LABELS qemu RUN_SERIAL ON TIMEOUT 900)
+# The watchdog: the image's control stage hangs, the CMSDK watchdog resets the board, and the
+# first heartbeat after the reset gives the cause (tests/qemu/pil_watchdog_test.py).
+add_test(NAME qemu_pil_watchdog
+         COMMAND /usr/bin/python3 ${CMAKE_CURRENT_SOURCE_DIR}/qemu/pil_watchdog_test.py
+                 --elf ${CMAKE_BINARY_DIR}/qemu-cortex-m4f/bin/drive_pil_mps2_an386.elf)
+set_tests_properties(qemu_pil_watchdog PROPERTIES LABELS qemu RUN_SERIAL ON TIMEOUT 300)

@@ -7,6 +7,10 @@
 
 namespace imd::firmware {
 
+/// The detail of an `overcurrent` that the power stage's hardware trip (the timer's break input)
+/// found rather than a phase's measurement.
+inline constexpr uint8_t kHardwareTripDetail = 3;
+
 struct Trip {
   uint16_t bits = 0;  ///< bit n: code n tripped
   FaultCode first = FaultCode::none;

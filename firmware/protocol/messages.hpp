@@ -176,7 +176,8 @@ inline constexpr Signal kFaultReportSignals[] = {
     {"first_fault", 0, 8, false, 1, 1, 0.0f, "", "first latched fault", kFaultValues},
     {"fault_bits", 8, 16, false, 1, 1, 0.0f, "", "latched faults, bit n = fault code n"},
     {"first_fault_time_ms", 24, 32, false, 1, 1, 0.0f, "ms", "drive time of the first fault"},
-    {"detail", 56, 8, false, 1, 1, 0.0f, "", "phase (0..2) for overcurrent and phase loss"},
+    {"detail", 56, 8, false, 1, 1, 0.0f, "",
+     "phase (0..2) for overcurrent and phase loss; 3: the power stage's hardware over-current trip"},
 };
 inline constexpr Signal kEmptyCommandSignals[] = {kE2eCrc, kE2eCounter};
 inline constexpr Signal kSetSpeedSignals[] = {

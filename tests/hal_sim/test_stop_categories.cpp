@@ -11,6 +11,7 @@
 
 #include "firmware/drive_state.hpp"
 #include "firmware/protection/stop_category.hpp"
+#include "firmware/protection/trip.hpp"
 #include "hal_sim/drive/scenario_run.hpp"
 #include "hal_sim/law_variant.hpp"
 #include "hal_sim/scenario.hpp"
@@ -154,6 +155,36 @@ TEST(StopCategories, AnOvercurrentIsStoWithTheBrakeAtOnce) {
   const StopTrace t = run(s);
   EXPECT_EQ(t.stop, int(StopCategory::sto));
   EXPECT_EQ(t.fault_state_s, t.detected_s);
+  EXPECT_TRUE(t.line_engaged_then);
+}
+
+TEST(StopCategories, TheHardwareOvercurrentTripIsLatched) {
+  // The power stage's comparator turns the outputs off on its own (TIM1's break input); the
+  // drive sees it in the next tick and latches `overcurrent` with detail 3, STO, the brake on.
+  Scenario s = board(50.0, 0.5, 5.0, 1.6);
+  StopTrace t;
+  bool tripped = false;
+  const Summary r = run_scenario(
+      s, {[&](const SimRow& row) {
+            if (std::isnan(t.detected_s) && row.stop != 0) {
+              t.detected_s = row.t_s;
+              t.stop = row.stop;
+              t.line_engaged_then = row.brake_line_engaged;
+            }
+          },
+          {},
+          {},
+          [&](uint64_t, double t_s, SimBoard& b, const firmware::DriveStatus&) {
+            if (!tripped && t_s >= 1.5) {
+              b.pwm_side().trip();
+              tripped = true;
+            }
+          }});
+  ASSERT_EQ(r.faults.size(), 1u);
+  EXPECT_EQ(r.faults.front().code, "overcurrent");
+  EXPECT_EQ(r.faults.front().detail, int(firmware::kHardwareTripDetail));
+  EXPECT_NEAR(r.faults.front().detected_at_s, 1.5, kTick_s / 2);
+  EXPECT_EQ(t.stop, int(StopCategory::sto));
   EXPECT_TRUE(t.line_engaged_then);
 }
 

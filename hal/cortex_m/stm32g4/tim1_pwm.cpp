@@ -41,6 +41,9 @@ constexpr uint32_t kBdtrLock1 = 0x1u << 8;  // DTG, OISx, BKE/BKP/AOE/BKF frozen
 constexpr uint32_t kBdtrOssi = 1u << 10;
 constexpr uint32_t kBdtrOssr = 1u << 11;
 constexpr uint32_t kBdtrMoe = 1u << 15;
+constexpr uint32_t kBdtrBke = 1u << 12, kBdtrBkp = 1u << 13;
+constexpr uint32_t kBdtrBkf8 = 0x3u << 16;  // BKF = 0011: 8 samples at f_CK_INT (47 ns)
+constexpr uint32_t kSrBif = 1u << 7;
 
 constexpr uint32_t kUpdatePolls = 1'000'000;  // >> 3 periods at 170 MHz
 
@@ -61,8 +64,13 @@ Tim1Pwm::Tim1Pwm(const Tim1PwmConfig& c) noexcept
     : arr_(c.timer_clock_Hz / (2u * c.pwm_frequency_Hz)),
       period_s_(float(2u * arr_) / float(c.timer_clock_Hz)) {
   reg32(kCr1) = 0;  // counter stopped: CMS may only change now
+  // The break input in the same write as LOCK 1, which freezes it: the comparator's output on
+  // BKIN clears MOE in hardware (within the 47 ns filter), and MOE stays off until software
+  // sets it again (AOE = 0).
+  const uint32_t brk = c.break_input ? kBdtrBke | kBdtrBkf8 | (c.break_active_low ? 0u : kBdtrBkp)
+                                     : 0u;
   reg32(kBdtr) = dead_time_code(c.dead_time_ns, c.timer_clock_Hz) | kBdtrLock1 | kBdtrOssi |
-                 kBdtrOssr;  // MOE = 0, BKE = 0
+                 kBdtrOssr | brk;  // MOE = 0
   reg32(kCr1) = kCr1CmsCenter1 | kCr1Arpe;
   reg32(kCr2) = kCr2Mms2Oc4ref;  // OISx = OISxN = 0: idle level low
   reg32(kPsc) = 0;
@@ -104,8 +112,11 @@ void Tim1Pwm::set_duties(const PhaseDuties& duty) noexcept {
 }
 
 void Tim1Pwm::enable() noexcept {
-  reg32(kBdtr) |= kBdtrMoe;
+  reg32(kSr) = ~kSrBif;  // rc_w0: a break that has passed no longer counts
+  reg32(kBdtr) |= kBdtrMoe;  // refused by the hardware while the break input is still active
 }
+
+bool Tim1Pwm::tripped() const noexcept { return (reg32(kSr) & kSrBif) != 0; }
 
 void Tim1Pwm::disable() noexcept {
   force_outputs_off();

@@ -12,10 +12,11 @@
 ///
 /// Safe state: MOE = 0 with OSSI = 1 drives every output to its idle level (OISx = OISxN = 0:
 /// both switches of each leg off). disable() and force_outputs_off() clear MOE. The hardware
-/// over-current trip belongs on the break input BKIN (PB12, AF6: an external comparator on the
-/// shunt amplifiers, active low): BKE = 1 clears MOE within the break filter time, without
-/// software. It is left off here until the power stage provides the comparator (bring-up
-/// checklist, docs/porting.md); the dead time and break settings are locked (LOCK level 1).
+/// over-current trip is the break input BKIN (PB12, AF6): the power stage's over-current
+/// comparator on the shunt amplifiers, active low, its threshold set in hardware above the
+/// firmware's trip. BKE = 1 clears MOE within the break filter time (47 ns), without software;
+/// tripped() tells the drive, which latches `overcurrent` with detail 3. The dead time and
+/// break settings are locked (LOCK level 1).
 #include <cstdint>
 
 #include "hal/pwm.hpp"
@@ -29,6 +30,8 @@ struct Tim1PwmConfig {
   /// OC4REF rises this many counts before the peak, so that the ADC's sampling window is
   /// centred on it (trigger latency plus half the sampling time; tune on a scope).
   uint32_t adc_trigger_lead_counts = 30;
+  bool break_input = true;        ///< BKIN clears the outputs (the over-current comparator)
+  bool break_active_low = true;   ///< the comparator pulls BKIN low on over-current
 };
 
 /// The DTG code of TIMx_BDTR for a dead time (RM0440 §28.6, TIMx_BDTR), tDTS = timer clock (CKD =
@@ -62,6 +65,7 @@ class Tim1Pwm final : public hal::Pwm {
   void enable() noexcept override;   ///< MOE = 1. Tick context.
   void disable() noexcept override;  ///< MOE = 0: all switches off. Tick context.
   bool enabled() const noexcept override;
+  bool tripped() const noexcept override;
   float period_s() const noexcept override { return period_s_; }
 
   /// The carrier's auto-reload value (half a period in counts).
