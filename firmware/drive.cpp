@@ -65,6 +65,9 @@ void Drive<T>::on_tick() noexcept {
   const Estimate<T> e = estimate(m, model);
   clock.lap(Stage::estimate);
   const TickPlan<T> plan = supervisor_.plan(k, m, e);
+  // A hardware trip is forgotten only when its fault is cleared (and found again at once if
+  // the comparator still holds the break input).
+  if (plan.supervised.restarted) hw_.pwm.clear_trip();
   clock.lap(Stage::supervise);
   const LawOutput<T> u = law(plan, e, m.v_bus_V, model);
   clock.lap(Stage::law);
@@ -191,7 +194,11 @@ inline LawOutput<T> Drive<T>::law(const TickPlan<T>& plan, const Estimate<T>& e,
   record_.law.voltage_limited = false;
   record_.law.limit = Limitation::none;
   // The commissioning drives the motor itself; a law would run on no estimate.
-  if (plan.mode == Mode::off || plan.mode == Mode::identifying || model == nullptr) return {};
+  // DC braking has no law either: the failed encoder's estimate is of no use to one.
+  if (plan.mode == Mode::off || plan.mode == Mode::identifying ||
+      plan.mode == Mode::dc_braking || model == nullptr) {
+    return {};
+  }
   const control::InputDisk<T> feasible = model->limits.feasible(e.x_input, v_bus_V);
   if (plan.mode == Mode::magnetizing) {
     return model->magnetizer.step(e.x_input, plan.next, supervisor_.controlled_flux(), feasible);
@@ -234,7 +241,8 @@ inline void Drive<T>::actuate(uint64_t k, const Estimate<T>& e, const Modulation
   if (trip.any() && supervisor_.latch(trip, k, motion)) {
     pwm_off();
     u_written_V_ = Vec2::Zero();
-  } else if (supervisor_.state() == DriveState::identifying || (out.direct && model != nullptr)) {
+  } else if (supervisor_.state() == DriveState::identifying ||
+             (out.direct && supervisor_.modulating() && model != nullptr)) {
     hw_.pwm.set_duties(out.duty);  // the commissioning's or DC braking's own voltage
     hw_.pwm.enable();
     u_written_V_ = out.u_alphabeta_V;

@@ -212,6 +212,7 @@ bool Supervisor<T>::latch(const Trip& trip, uint64_t k, const StopContext<T>& mo
     status_.stop = StopCategory::sto;
     machine_.go(DriveState::fault, TransitionReason::fault, k);
     status_.state = DriveState::fault;
+    if (wiring_.can != nullptr) wiring_.telemetry.report_fault(*wiring_.can, status_);
     return true;
   }
   if (machine_.state() == DriveState::identifying) {
@@ -248,6 +249,7 @@ void Supervisor<T>::end_fault_stop(uint64_t k, TickPlan<T>& p) noexcept {
 
 template <typename T>
 void Supervisor<T>::shut_down(uint64_t k) noexcept {
+  fault_stop_ = false;  // the program ends: no stop runs on
   if (modulating()) machine_.go(DriveState::idle, TransitionReason::shutdown, k);
   status_.state = machine_.state();
 }

@@ -24,6 +24,8 @@ class Pwm {
   /// The power stage's own protection (a hardware over-current comparator on the timer's break
   /// input) turned the outputs off since the last enable, without software. Tick context.
   virtual bool tripped() const noexcept { return false; }
+  /// Forgets a trip (the drive's fault was cleared); until then enable() is refused.
+  virtual void clear_trip() noexcept {}
   /// Carrier period, fixed at configuration.
   virtual float period_s() const noexcept = 0;
 };

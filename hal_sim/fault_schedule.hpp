@@ -17,17 +17,18 @@ class FaultSchedule {
 
   /// Injects the faults due by the tick at `t_s`, and calls `on_injected(fault, accepted)` for
   /// each: `accepted` is false for a fault the board refuses (fault_parameter_error says why).
-  /// First repairs the injected faults whose until_s has come since the last call.
+  /// Then repairs the injected faults whose until_s has come since the last call (one that
+  /// ends within the tick it began in never acts).
   template <typename OnInjected>
   void inject_due(SimBoard& board, double t_s, OnInjected&& on_injected) {
+    for (; next_ < count_ && faults_[next_].at_s <= t_s + 1e-12; ++next_) {
+      on_injected(faults_[next_], board.inject(faults_[next_]));
+    }
     for (std::size_t i = 0; i < next_; ++i) {
       const double until_s = faults_[i].until_s;
       if (until_s > last_t_s_ + 1e-12 && until_s <= t_s + 1e-12) board.repair(faults_[i]);
     }
     last_t_s_ = t_s;
-    for (; next_ < count_ && faults_[next_].at_s <= t_s + 1e-12; ++next_) {
-      on_injected(faults_[next_], board.inject(faults_[next_]));
-    }
   }
   /// Faults injected (or refused) so far.
   std::size_t done() const noexcept { return next_; }

@@ -18,10 +18,8 @@ class SimPwm final : public hal::Pwm {
  public:
   explicit SimPwm(float period_s) : period_s_(period_s) {}
   void set_duties(const hal::PhaseDuties& duty) noexcept override { written_ = duty; }
-  void enable() noexcept override {
-    tripped_ = false;  // as TIM1: the break flag cleared, the outputs on
-    enabled_ = true;
-  }
+  void enable() noexcept override { enabled_ = !tripped_; }  // as TIM1: not after a break
+  void clear_trip() noexcept override { tripped_ = false; }
   void disable() noexcept override { enabled_ = false; }
   bool enabled() const noexcept override { return enabled_; }
   bool tripped() const noexcept override { return tripped_; }

@@ -44,6 +44,12 @@ class PhaseLossCheck {
     std::fill(std::begin(measured_A_), std::end(measured_A_), T(0));
     ticks_ = 0;
   }
+  /// The inverter does not drive the motor: start afresh, and skip the first tick after, whose
+  /// prediction took the open terminals of a PWM-off period for a zero voltage.
+  void idle() noexcept {
+    reset();
+    skip_ = true;
+  }
 
   /// Takes over the sums of the check this one replaces (the same motor but for its rotor
   /// resistance: a window a little longer or shorter).
@@ -51,10 +57,15 @@ class PhaseLossCheck {
     std::copy(std::begin(old.predicted_A_), std::end(old.predicted_A_), predicted_A_);
     std::copy(std::begin(old.measured_A_), std::end(old.measured_A_), measured_A_);
     ticks_ = old.ticks_;
+    skip_ = old.skip_;
   }
 
   /// Predicted and measured phase currents, the DC bus. The lost phase (0..2), or -1.
   int lost_phase(const T (&i_predicted_abc_A)[3], const T (&i_abc_A)[3], T v_bus_V) noexcept {
+    if (skip_) {
+      skip_ = false;
+      return -1;
+    }
     for (int k = 0; k < 3; ++k) {
       predicted_A_[k] += std::abs(i_predicted_abc_A[k]);
       measured_A_[k] += std::abs(i_abc_A[k]);
@@ -77,6 +88,7 @@ class PhaseLossCheck {
   T predicted_A_[3] = {T(0), T(0), T(0)};
   T measured_A_[3] = {T(0), T(0), T(0)};
   uint32_t ticks_ = 0;
+  bool skip_ = true;
 };
 
 }  // namespace imd::firmware

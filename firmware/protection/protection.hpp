@@ -64,7 +64,7 @@ struct MotorChecks {
   /// the driven motor start afresh.
   void idle() noexcept {
     adc_stuck.reset();
-    phase_loss.reset();
+    phase_loss.idle();
   }
   /// Takes over the checks' state from the model this one replaces (firmware/motor_model.hpp).
   void continue_from(const MotorChecks& old) noexcept {

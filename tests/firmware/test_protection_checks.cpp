@@ -302,7 +302,22 @@ TEST(PhaseLossCheck, AnOpenPhaseIsFoundInOneWindow) {
     lost = check.lost_phase(predicted, measured, 311.0);
   }
   EXPECT_EQ(lost, 1);
-  EXPECT_EQ(k, 25);
+  EXPECT_EQ(k, 1 + 25);  // the first tick after the PWM came on is skipped, then one window
+}
+
+TEST(PhaseLossCheck, TheFirstTickAfterThePwmWasOffIsNotJudged) {
+  // Its prediction took the open terminals of a PWM-off period for zero volts: a motor turning
+  // at speed would show a whole tick's back-EMF worth of shortfall that is not there.
+  PhaseLossCheck<double> check(phase_loss_config());
+  for (int round = 0; round < 3; ++round) {
+    check.idle();
+    const double wrong[3] = {50.0, -25.0, -25.0}, zero[3] = {0.0, 0.0, 0.0};
+    EXPECT_EQ(check.lost_phase(wrong, zero, 311.0), -1);
+    for (int k = 0; k < 25; ++k) {
+      const double healthy[3] = {0.5, -0.25, -0.25};  // little: the wrong tick would weigh
+      ASSERT_EQ(check.lost_phase(healthy, healthy, 311.0), -1) << k;
+    }
+  }
 }
 
 TEST(PhaseLossCheck, AShortfallWithinTheBoundsIsNotALoss) {
@@ -312,7 +327,7 @@ TEST(PhaseLossCheck, AShortfallWithinTheBoundsIsNotALoss) {
   const auto judge = [](double predicted_A, double measured_A) {
     PhaseLossCheck<double> check(phase_loss_config());
     int lost = -1;
-    for (int k = 0; k < 25; ++k) {
+    for (int k = 0; k < 1 + 25; ++k) {  // the skipped first tick, then one window
       const double predicted[3] = {predicted_A, 3.0, -3.0}, measured[3] = {measured_A, 3.0, -3.0};
       lost = check.lost_phase(predicted, measured, 311.0);
     }

@@ -32,13 +32,13 @@ std::vector<std::string> profile(const std::string& law, double speed_rad_s, dou
 
 TEST(EncoderCheckSweep, NoFalseTripAtLowSpeedUnderLoadSteps) {
   // Speeds 0..5 rad/s (a count every 0.8 ms at 1 rad/s, none for seconds at 0), load steps
-  // 0.2..2 N m that stop the rotor for a moment at the lowest speeds, three noise seeds, the
-  // two voltage-fed laws: 108 runs, none may trip anything.
+  // 0.2..2 N m that stop the rotor for a moment at the lowest speeds, five noise seeds, the
+  // two voltage-fed laws: 180 runs, none may trip anything.
   int runs = 0;
   for (const char* law : {"dsmc", "ifoc"}) {
     for (const double speed : {0.0, 0.25, 0.5, 1.0, 2.0, 5.0}) {
       for (const double load : {0.2, 1.0, 2.0}) {
-        for (const int seed : {1, 2, 3}) {
+        for (const int seed : {1, 2, 3, 4, 5}) {
           const Summary r =
               run_scenario(load_scenario(test::source_path(kBoard), profile(law, speed, load, seed)));
           ++runs;

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdio>
 #include <string>
+#include <utility>
 
 #include "firmware/drive_state.hpp"
 #include "firmware/protection/stop_category.hpp"
@@ -158,12 +159,20 @@ TEST(StopCategories, AnOvercurrentIsStoWithTheBrakeAtOnce) {
   EXPECT_TRUE(t.line_engaged_then);
 }
 
-TEST(StopCategories, TheHardwareOvercurrentTripIsLatched) {
+TEST(StopCategories, TheHardwareOvercurrentTripIsLatchedAndCleared) {
   // The power stage's comparator turns the outputs off on its own (TIM1's break input); the
   // drive sees it in the next tick and latches `overcurrent` with detail 3, STO, the brake on.
-  Scenario s = board(50.0, 0.5, 5.0, 1.6);
+  // The host clears the fault at 1.7 s and enables at 1.8 s: the drive runs again.
+  Scenario s = board(50.0, 0.5, 5.0, 2.5);
+  for (const auto& [at_s, message] : {std::pair{1.7, "clear_faults"}, std::pair{1.8, "enable"}}) {
+    CanCommandScript c;
+    c.index = int(s.can_commands.size());
+    c.at_s = at_s;
+    c.message = message;
+    s.can_commands.push_back(c);
+  }
   StopTrace t;
-  bool tripped = false;
+  bool tripped = false, ran_again = false;
   const Summary r = run_scenario(
       s, {[&](const SimRow& row) {
             if (std::isnan(t.detected_s) && row.stop != 0) {
@@ -171,6 +180,7 @@ TEST(StopCategories, TheHardwareOvercurrentTripIsLatched) {
               t.stop = row.stop;
               t.line_engaged_then = row.brake_line_engaged;
             }
+            if (row.t_s > 1.8 && row.state == int(DriveState::running)) ran_again = true;
           },
           {},
           {},
@@ -186,6 +196,7 @@ TEST(StopCategories, TheHardwareOvercurrentTripIsLatched) {
   EXPECT_NEAR(r.faults.front().detected_at_s, 1.5, kTick_s / 2);
   EXPECT_EQ(t.stop, int(StopCategory::sto));
   EXPECT_TRUE(t.line_engaged_then);
+  EXPECT_TRUE(ran_again) << "cleared, the trip is forgotten and the drive runs again";
 }
 
 }  // namespace

@@ -7,6 +7,7 @@
 
 #include "control/motor_parameters.hpp"
 #include "firmware/drive_state.hpp"
+#include "firmware/protocol/commands.hpp"
 #include "firmware/protocol/e2e.hpp"
 #include "firmware/protocol/frame_codec.hpp"
 
@@ -100,6 +101,11 @@ void SoakHost::violation(double t_s, const std::string& what) {
 void SoakHost::before_tick(uint64_t, double t_s, sim::SimBoard& board,
                            const firmware::DriveStatus& status) {
   t_s_ = t_s;
+  // As a host does from the heartbeat's command_counter: frames lost in a silence moved the
+  // host's counter beyond the step the drive accepts; take up from the drive's.
+  if (((counter_ - status.command_counter) & 0x0F) > firmware::protocol::kMaxCounterStep) {
+    counter_ = uint8_t((status.command_counter + 1) & 0x0F);
+  }
   if (!repaired_ && t_s >= repair_at_s_) {
     board.repair(fault_);
     repaired_ = true;
@@ -134,15 +140,16 @@ void SoakHost::before_tick(uint64_t, double t_s, sim::SimBoard& board,
     enable_at_s_ = t_s + 0.1;
     next_segment_s_ = t_s + 0.5;
   }
+  // The watchdog fed in every phase: a slow detection must not turn into a command_timeout.
+  if (modulating(status) && t_s >= next_keepalive_s_) {
+    send(board, MessageId::set_speed, float(speed_ref_rad_s_));
+    next_keepalive_s_ = t_s + 0.05;
+  }
   if (phase_ != Phase::running) return;
   if (status.state == DriveState::idle && t_s >= enable_at_s_) {  // (again, if refused)
     send(board, MessageId::enable, 0.0f);
     enable_at_s_ = t_s + 0.5;
     next_keepalive_s_ = t_s + 0.01;
-  }
-  if (modulating(status) && t_s >= next_keepalive_s_) {
-    send(board, MessageId::set_speed, float(speed_ref_rad_s_));
-    next_keepalive_s_ = t_s + 0.05;
   }
   if (t_s >= next_segment_s_) start_segment(t_s, board, status);
 }
@@ -176,6 +183,7 @@ void SoakHost::start_segment(double t_s, sim::SimBoard& board,
   } else if (action < 0.78) {
     send(board, MessageId::emergency_stop, 0.0f);
     expecting_ = true;
+    surge_ = false;
     expected_code_ = "emergency_stop";
     phase_ = Phase::waiting_fault;
     phase_until_s_ = t_s + 1.0;
@@ -197,6 +205,7 @@ void SoakHost::start_segment(double t_s, sim::SimBoard& board,
     repaired_ = false;
     repair_at_s_ = f.until_s;
     expecting_ = true;
+    surge_ = f.kind == sim::FaultKind::overcurrent;
     expected_code_ = expected_code(f.kind);
     phase_ = Phase::waiting_fault;
     phase_until_s_ = t_s + 1.0;
@@ -218,7 +227,7 @@ void SoakHost::after_tick(const sim::SimRow& row) {
   if (std::abs(row.omega_mech_rad_s) > 1.5 * overspeed_rad_s_) {
     violation(row.t_s, fmt::format("speed {:.1f} rad/s", row.omega_mech_rad_s));
   }
-  const bool surge = expecting_ && fault_.kind == sim::FaultKind::overcurrent;
+  const bool surge = expecting_ && surge_;
   const double i_A = std::hypot(row.i_alpha_A, row.i_beta_A);
   if (!surge && i_A > overcurrent_A_) violation(row.t_s, fmt::format("current {:.2f} A", i_A));
 }

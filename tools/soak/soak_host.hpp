@@ -66,6 +66,7 @@ class SoakHost {
   Phase phase_ = Phase::running;
   double phase_until_s_ = 0.0;  ///< the waiting phase's deadline
   bool expecting_ = false;      ///< a fault (injected, or an emergency stop) is due
+  bool surge_ = false;          ///< the fault due is an over-current surge
   sim::FaultInjection fault_;   ///< the one injected, while expecting_
   const char* expected_code_ = "";
   double repair_at_s_ = 0.0;

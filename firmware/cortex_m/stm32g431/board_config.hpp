@@ -30,8 +30,11 @@ inline constexpr double kCurrentLimit_A = 6.0;   ///< motor and inverter limit t
 inline constexpr uint32_t kPwmFrequency_Hz = 10'000;
 inline constexpr uint32_t kControlPeriod_ns = 1'000'000'000u / kPwmFrequency_Hz;
 inline constexpr uint32_t kDeadTime_ns = 1'000;  ///< IGBT/MOSFET leg with isolated gate drivers
-/// The independent watchdog: 20 control periods (firmware/cortex_m/stm32g431/main.cpp).
-inline constexpr uint32_t kWatchdogTimeout_us = 20 * kControlPeriod_ns / 1000;
+/// The independent watchdog's period: it must outlast the longest stall of a healthy tick, a
+/// flash page erase (a parameter save), which on the single-bank G431 stalls every fetch from
+/// flash, the tick's included, for up to 40 ms (datasheet t_ERASE). 100 ms; a shorter one
+/// needs the erase (or the tick) run from RAM.
+inline constexpr uint32_t kWatchdogTimeout_us = 100'000;
 
 /// Analog front end: 10 mOhm shunts, x16.5 amplifiers biased at 1.65 V (+-10 A full scale),
 /// DC-bus divider 1.5 MOhm / 10 kOhm (498 V full scale).

@@ -91,10 +91,10 @@ int main() {
   static hal::PagePairStore<firmware::kMotorRecordBytes> store(flash);
   std::array<uint8_t, firmware::kMotorRecordBytes> record{};
   const std::size_t record_bytes = store.load(record);
-  // The independent watchdog, fed by the control stage only: 2 ms, 20 ticks, well past the
-  // longest tick (its budget is 90 us) plus the main loop's work, which the tick preempts.
+  // The independent watchdog, fed by the control stage only, started once the ticks run (the
+  // drive's construction builds the motor model, about 12 ms).
   const hal::ResetCause reset_cause = g4::take_reset_cause();
-  static g4::Iwdg watchdog(kWatchdogTimeout_us);
+  static g4::Iwdg watchdog;
   // The drive follows its own CAN-commanded references (commands_over_can).
   static firmware::Drive<float> drive(
       firmware::decode_motor_record(std::span<const uint8_t>(record).first(record_bytes)),
@@ -104,6 +104,7 @@ int main() {
   if (!pwm.start()) halt(BootFailure::pwm_phase);
   g4::bind_adc_tick_interrupts(tick);
   tick.start(drive);
+  watchdog.start(kWatchdogTimeout_us);
   for (;;) {
     can.pump();       // frames the last tick queued leave now, outside the tick
     drive.service();  // a parameter write's new model, a save: outside the tick

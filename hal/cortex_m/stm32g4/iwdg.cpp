@@ -20,7 +20,7 @@ constexpr uint32_t kCsrIwdg = 1u << 29, kCsrWwdg = 1u << 30;
 
 }  // namespace
 
-Iwdg::Iwdg(uint32_t timeout_us) noexcept {
+void Iwdg::start(uint32_t timeout_us) noexcept {
   const uint32_t counts_per_s = kLsi_Hz / 4;
   uint32_t reload = uint32_t(uint64_t(timeout_us) * counts_per_s / 1'000'000u);
   reload = reload < 1 ? 1 : (reload > 0xFFF ? 0xFFF : reload);
@@ -28,8 +28,8 @@ Iwdg::Iwdg(uint32_t timeout_us) noexcept {
   reg32(kKr) = kKeyUnlock;  // PR and RLR writable
   reg32(kPr) = kPrescaler4;
   reg32(kRlr) = reload;
-  while ((reg32(kSr) & kSrBusy) != 0) {
-  }
+  for (uint32_t n = 0; n < 1'000'000 && (reg32(kSr) & kSrBusy) != 0; ++n) {
+  }  // 5 LSI cycles, 160 us; bounded: a stuck update still leaves the watchdog running
   reg32(kKr) = kKeyFeed;  // reloads the counter, and locks PR and RLR again
 }
 

@@ -3,7 +3,8 @@
 /// RM0440 §7.4.29). The IWDG runs from the LSI (32 kHz), which its start turns on by hardware,
 /// and nothing but a reset stops it once started. The drive feeds it at the end of every
 /// tick's control stage (firmware/drive.cpp): a tick that stalls or never comes lets it expire,
-/// and the reset starts the board with TIM1's outputs off (its reset state).
+/// and the reset starts the board with TIM1 stopped, its pins floating until main configures
+/// them (the gate drivers' pull-downs keep the switches off, docs/porting.md).
 #include <cstdint>
 
 #include "hal/watchdog.hpp"
@@ -13,8 +14,9 @@ namespace imd::hal::cortex_m::stm32g4 {
 class Iwdg final : public hal::Watchdog {
  public:
   /// Starts it with a period of `timeout_us` (rounded down to the LSI's 125 us at prescaler
-  /// 4; 125 us .. 512 ms). Returns once the prescaler and reload are taken.
-  explicit Iwdg(uint32_t timeout_us) noexcept;
+  /// 4; 125 us .. 512 ms; the LSI is good to about 8 %). Returns once the prescaler and reload
+  /// are taken (a few LSI cycles). Until then feed() does nothing.
+  void start(uint32_t timeout_us) noexcept;
   void feed() noexcept override;
 };
 

@@ -112,9 +112,13 @@ void Tim1Pwm::set_duties(const PhaseDuties& duty) noexcept {
 }
 
 void Tim1Pwm::enable() noexcept {
-  reg32(kSr) = ~kSrBif;  // rc_w0: a break that has passed no longer counts
-  reg32(kBdtr) |= kBdtrMoe;  // refused by the hardware while the break input is still active
+  // Not after a break until the drive has latched it and cleared it (clear_trip); the hardware
+  // itself refuses MOE while the break input is still active.
+  if (tripped()) return;
+  reg32(kBdtr) |= kBdtrMoe;
 }
+
+void Tim1Pwm::clear_trip() noexcept { reg32(kSr) = ~kSrBif; }  // rc_w0: writing 0 clears
 
 bool Tim1Pwm::tripped() const noexcept { return (reg32(kSr) & kSrBif) != 0; }
 

@@ -66,6 +66,7 @@ class Tim1Pwm final : public hal::Pwm {
   void disable() noexcept override;  ///< MOE = 0: all switches off. Tick context.
   bool enabled() const noexcept override;
   bool tripped() const noexcept override;
+  void clear_trip() noexcept override;
   float period_s() const noexcept override { return period_s_; }
 
   /// The carrier's auto-reload value (half a period in counts).
