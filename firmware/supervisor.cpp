@@ -206,8 +206,10 @@ bool Supervisor<T>::latch(const Trip& trip, uint64_t k, const StopContext<T>& mo
                        !(std::abs(motion.omega_mech_rad_s) > stop_speed_rad_s_)))) {
     stop = StopCategory::sto;
   }
-  if (fault_stop_) {  // an earlier fault's stop runs: only STO overrides it
-    if (stop != StopCategory::sto) return false;
+  if (fault_stop_) {  // an earlier fault's stop runs: STO overrides it, and so does a fault
+    // that takes speed control away from an SS1 ramp (the encoder: no DC braking from here)
+    const bool ramp_lost = stop == StopCategory::dc_brake && status_.stop == StopCategory::ss1;
+    if (stop != StopCategory::sto && !ramp_lost) return false;
     fault_stop_ = false;
     status_.stop = StopCategory::sto;
     machine_.go(DriveState::fault, TransitionReason::fault, k);

@@ -146,6 +146,31 @@ TEST(StopCategories, ACommandTimeoutRampsToStandstillBeforeSto) {
   EXPECT_LT(ramp_s, 50.0 / 200.0 + 0.1);  // the ramp, then the speed loop's settling
 }
 
+TEST(StopCategories, AnEncoderFaultDuringSs1EndsTheRampInSto) {
+  // The SS1 ramp of a CAN silence (from 0.56 s) needs the encoder; frozen at 0.62 s, the ramp
+  // cannot go on and DC braking cannot start from a stop under way: STO at once.
+  Scenario s = load_scenario(test::source_path("hal_sim/scenarios/seed000_can.toml"));
+  s.brake.holding_torque_Nm = 5.0;
+  FaultInjection silence, encoder;
+  silence.at_s = 0.4;
+  silence.kind = FaultKind::can_silence;
+  encoder.at_s = 0.62;
+  encoder.kind = FaultKind::encoder_loss;
+  s.faults = {silence, encoder};
+  StopTrace t;
+  run_scenario(s, {[&](const SimRow& row) {
+                     if (std::isnan(t.fault_state_s) && row.state == int(DriveState::fault)) {
+                       t.fault_state_s = row.t_s;
+                       t.line_engaged_at_sto = row.brake_line_engaged;
+                     }
+                   },
+                   {},
+                   {}});
+  ASSERT_FALSE(std::isnan(t.fault_state_s));
+  EXPECT_LT(t.fault_state_s, 0.62 + 0.01);  // the encoder check's detection at speed, then STO
+  EXPECT_TRUE(t.line_engaged_at_sto);
+}
+
 TEST(StopCategories, AnOvercurrentIsStoWithTheBrakeAtOnce) {
   Scenario s = board(50.0, 1.5, 5.0, 1.6);
   FaultInjection f;
