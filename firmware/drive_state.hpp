@@ -35,7 +35,7 @@ enum class FaultCode : uint8_t {
   overspeed,
   encoder,          ///< no counts where the motion model demands them, or an implausible jump
   adc_stuck,        ///< the phase-current codes stopped changing while the voltage moved
-  phase_loss,       ///< one phase carries no current over an electrical revolution
+  phase_loss,       ///< a phase carries much less current than the model says it should
   command_timeout,  ///< no valid command frame within the watchdog timeout while enabled
   emergency_stop,   ///< the emergency-stop command
   enable_input,     ///< the hardware enable input went inactive while the PWM was on
