@@ -20,7 +20,6 @@
 #include "control/ifoc_design.hpp"
 #include "control/motor_parameters.hpp"
 #include "firmware/drive_config.hpp"
-#include "firmware/duration_ticks.hpp"
 
 namespace imd::firmware {
 
@@ -38,28 +37,29 @@ class DcBrake {
     // No current (no current limit given): no DC braking.
     if (std::isfinite(current_A) && current_A > 0.0) {
       const double k = 1.5 * m.pole_pairs * m.Lm_H * m.Lm_H / m.Lr_H;
-      seconds_per_unit_ = m.J_kgm2 / (k * current_A * current_A * m.pole_pairs * tau_r_s);
+      ticks_per_unit_ =
+          T(m.J_kgm2 / (k * current_A * current_A * m.pole_pairs * tau_r_s) / c.sample_period_s);
     } else {
       current_A_ = T(0);
     }
-    x_per_rad_s_ = m.pole_pairs * tau_r_s;
-    x_stop_ = x_per_rad_s_ * c.stop_speed_rad_s;
-    settle_s_ = 3.0 * tau_r_s;
-    period_s_ = c.sample_period_s;
-    max_s_ = c.stop_timeout_s;
+    x_per_rad_s_ = T(m.pole_pairs * tau_r_s);
+    x_stop_ = T(m.pole_pairs * tau_r_s * c.stop_speed_rad_s);
+    settle_ticks_ = T(3.0 * tau_r_s / c.sample_period_s);
+    const double max_ticks = c.stop_timeout_s / c.sample_period_s;
+    max_ticks_ = T(max_ticks < 1e7 ? max_ticks : 1e7);  // within float's integers
   }
 
   /// Starts braking from the speed at detection: the ticks it lasts, 0 if it cannot brake
   /// (no current, or no motion to stop). Resets the current loop.
   uint64_t begin(T omega_mech_rad_s) noexcept {
     integral_V_ = control::Vec2<T>::Zero();
-    const double x0 = x_per_rad_s_ * std::abs(double(omega_mech_rad_s));
+    const T x0 = x_per_rad_s_ * std::abs(omega_mech_rad_s);
     if (current_A_ == T(0) || !(x0 > x_stop_)) return 0;
-    const double t_s = std::min(
-        seconds_per_unit_ * (std::log(x0 / x_stop_) + (x0 * x0 - x_stop_ * x_stop_) / 2.0) +
-            settle_s_,
-        max_s_);
-    return duration_ticks(t_s, period_s_);
+    const T ticks = std::min(
+        ticks_per_unit_ * (std::log(x0 / x_stop_) + (x0 * x0 - x_stop_ * x_stop_) / T(2)) +
+            settle_ticks_,
+        max_ticks_);
+    return uint64_t(static_cast<uint32_t>(ticks)) + 1;  // in T, and 32 bits: no double on the MCU
   }
 
   /// The stator voltage that holds the current along alpha, within the disk v_max.
@@ -79,8 +79,8 @@ class DcBrake {
 
  private:
   T current_A_, kp_V_per_A_ = T(0), ki_V_per_A_tick_ = T(0);
-  double seconds_per_unit_ = 0.0, x_per_rad_s_ = 0.0, x_stop_ = 0.0, settle_s_ = 0.0;
-  double period_s_ = 0.0, max_s_ = 0.0;
+  T ticks_per_unit_ = T(0), x_per_rad_s_ = T(0), x_stop_ = T(0), settle_ticks_ = T(0);
+  T max_ticks_ = T(0);
   control::Vec2<T> integral_V_ = control::Vec2<T>::Zero();
 };
 
