@@ -35,29 +35,29 @@ struct StopTrace {
   bool line_engaged_at_sto = false;
   double still_from_s = NAN;    ///< |w| < 1 rad/s from here to the end of the run
   double speed_at_sto_rad_s = NAN;
+
+  void observe(const SimRow& row) {
+    if (std::isnan(detected_s) && row.stop != 0) {
+      detected_s = row.t_s;
+      stop = row.stop;
+      line_engaged_then = row.brake_line_engaged;
+    }
+    if (std::isnan(fault_state_s) && row.state == int(DriveState::fault)) {
+      fault_state_s = row.t_s;
+      line_engaged_at_sto = row.brake_line_engaged;
+      speed_at_sto_rad_s = row.omega_mech_rad_s;
+    }
+    if (std::abs(row.omega_mech_rad_s) >= 1.0) {
+      still_from_s = NAN;
+    } else if (std::isnan(still_from_s)) {
+      still_from_s = row.t_s;
+    }
+  }
 };
 
 StopTrace run(const Scenario& s) {
   StopTrace t;
-  const Summary r = run_scenario(s, {[&](const SimRow& row) {
-                     if (std::isnan(t.detected_s) && row.stop != 0) {
-                       t.detected_s = row.t_s;
-                       t.stop = row.stop;
-                       t.line_engaged_then = row.brake_line_engaged;
-                     }
-                     if (std::isnan(t.fault_state_s) && row.state == int(DriveState::fault)) {
-                       t.fault_state_s = row.t_s;
-                       t.line_engaged_at_sto = row.brake_line_engaged;
-                       t.speed_at_sto_rad_s = row.omega_mech_rad_s;
-                     }
-                     if (std::abs(row.omega_mech_rad_s) >= 1.0) {
-                       t.still_from_s = NAN;
-                     } else if (std::isnan(t.still_from_s)) {
-                       t.still_from_s = row.t_s;
-                     }
-                   },
-                   {},
-                   {}});
+  const Summary r = run_scenario(s, {[&](const SimRow& row) { t.observe(row); }, {}, {}});
   EXPECT_LE(r.faults.size(), 1u) << "one fault, one stop";
   return t;
 }
@@ -158,14 +158,7 @@ TEST(StopCategories, AnEncoderFaultDuringSs1EndsTheRampInSto) {
   encoder.kind = FaultKind::encoder_loss;
   s.faults = {silence, encoder};
   StopTrace t;
-  run_scenario(s, {[&](const SimRow& row) {
-                     if (std::isnan(t.fault_state_s) && row.state == int(DriveState::fault)) {
-                       t.fault_state_s = row.t_s;
-                       t.line_engaged_at_sto = row.brake_line_engaged;
-                     }
-                   },
-                   {},
-                   {}});
+  run_scenario(s, {[&](const SimRow& row) { t.observe(row); }, {}, {}});
   ASSERT_FALSE(std::isnan(t.fault_state_s));
   EXPECT_LT(t.fault_state_s, 0.62 + 0.01);  // the encoder check's detection at speed, then STO
   EXPECT_TRUE(t.line_engaged_at_sto);
@@ -200,11 +193,7 @@ TEST(StopCategories, TheHardwareOvercurrentTripIsLatchedAndCleared) {
   bool tripped = false, ran_again = false;
   const Summary r = run_scenario(
       s, {[&](const SimRow& row) {
-            if (std::isnan(t.detected_s) && row.stop != 0) {
-              t.detected_s = row.t_s;
-              t.stop = row.stop;
-              t.line_engaged_then = row.brake_line_engaged;
-            }
+            t.observe(row);
             if (row.t_s > 1.8 && row.state == int(DriveState::running)) ran_again = true;
           },
           {},
