@@ -9,7 +9,7 @@
 # Idempotent: when everything is present it changes nothing and needs no network.
 set -eu
 packages="g++ cmake ninja-build libeigen3-dev libtomlplusplus-dev libcli11-dev nlohmann-json3-dev
-libfmt-dev libgtest-dev libbenchmark-dev libgpiod-dev python3"
+libfmt-dev libgtest-dev libbenchmark-dev libgpiod-dev python3 python3-can python3-pytest"
 arm64=no
 for option in "$@"; do
   case "$option" in
