@@ -3,6 +3,7 @@
 //   drive_model discretize --motor FILE.toml [--sample-period-s S] [--control-period-s T0]
 //
 // Exit codes: 0 success, 2 bad input (command line, motor file).
+#include <imd_version.hpp>
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
@@ -95,6 +96,7 @@ const CLI::Validator kPeriod(
 
 int main(int argc, char** argv) {
   CLI::App app{"Exact discretizations of the induction-motor models of both papers."};
+  app.set_version_flag("--version", imd::version::kText);
   app.require_subcommand(1);
   std::string motor_path;
   double delta_s = 1e-4;

@@ -21,6 +21,7 @@
 //
 // Exit codes: 0 success, 1 the report could not be written or the plant diverged, 2 bad input
 // (command line, scenario, CAN interface, GPIO chip or line).
+#include <imd_version.hpp>
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
 
@@ -220,6 +221,7 @@ int run(const Options& o, const imd::sim::Scenario& s, imd::hal::QueuedCanBus* c
 int main(int argc, char** argv) {
   Options o;
   CLI::App app{"Runs the drive firmware in real time against the simulated motor, over CAN."};
+  app.set_version_flag("--version", imd::version::kText);
   app.add_option("scenario", o.scenario, "Scenario file (TOML)")->required();
   app.add_option("--can", o.can, "SocketCAN interface, e.g. can0 or vcan0; 'none': no bus")
       ->required();

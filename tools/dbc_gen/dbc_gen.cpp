@@ -1,5 +1,6 @@
 // dbc_gen: writes the DBC file and the Markdown reference of the drive's CAN protocol for one
 // node, from the message table in firmware/protocol/messages.hpp.
+#include <imd_version.hpp>
 #include <CLI/CLI.hpp>
 #include <cerrno>
 #include <cstring>
@@ -47,6 +48,7 @@ std::string write_file(const std::string& flag, const std::string& path, const s
 
 int main(int argc, char** argv) {
   CLI::App app{"Writes the DBC file (and a Markdown reference) of the drive's CAN protocol."};
+  app.set_version_flag("--version", imd::version::kText);
   int node_id = 1;
   std::string dbc_path, markdown_path;
   app.add_option("--node", node_id, "CAN node id of the drive")

@@ -31,6 +31,7 @@
 // identify starts the commissioning (the drive's record must hold the nameplate), prints its
 // progress, and on success reads the identified record back as parameters does; exit code 3
 // when the drive refuses or the run fails (the reason is printed), 4 when it does not answer.
+#include <imd_version.hpp>
 #include <poll.h>
 #include <unistd.h>
 #include <CLI/CLI.hpp>
@@ -303,6 +304,7 @@ int send(const SendOptions& o) {
 
 int main(int argc, char** argv) {
   CLI::App app{"Watches an induction-motor drive on CAN and sends it commands."};
+  app.set_version_flag("--version", imd::version::kText);
   app.require_subcommand(1);
 
   WatchOptions w;

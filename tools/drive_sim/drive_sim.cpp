@@ -7,6 +7,7 @@
 // Prints the summary (JSON) on standard output. Exit codes: 0 success, 2 bad input (command
 // line or scenario file), 1 an output could not be written, 3 a commissioning run identified
 // no motor (the summary says why).
+#include <imd_version.hpp>
 #include <fmt/format.h>
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
@@ -163,6 +164,7 @@ int run_program(std::vector<std::string> args) {
 
 int main(int argc, char** argv) {
   CLI::App app{"Runs the drive firmware on the simulated board for a scenario file."};
+  app.set_version_flag("--version", imd::version::kText);
   std::string scenario_path, csv_path, summary_path, plot_path, can_log_path, motor_out_path;
   std::optional<std::string> model_file;
   std::optional<double> duration_s;

@@ -4,6 +4,7 @@
 // with 17 significant digits, so the image runs exactly what drive_sim runs.
 //   scenario_embed SCENARIO --name NAME --symbol kName --output FILE.cpp
 // Exit codes: 0, 2 (bad input: the loader's message naming the key).
+#include <imd_version.hpp>
 #include <fmt/format.h>
 
 #include <CLI/CLI.hpp>
@@ -263,6 +264,7 @@ std::string embed(const imd::sim::Scenario& s, const std::string& name,
 
 int main(int argc, char** argv) {
   CLI::App app{"Writes a scenario file as C++ source for an image without a file system."};
+  app.set_version_flag("--version", imd::version::kText);
   std::string scenario_path, name, symbol, output;
   app.add_option("scenario", scenario_path, "Scenario file (TOML)")->required();
   app.add_option("--name", name, "Name the image prints, e.g. seed000_realistic")->required();

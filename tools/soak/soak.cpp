@@ -2,6 +2,7 @@
 // tick (tools/soak/soak_host.hpp; docs/safety.md, "Soak"). Exit code 0 when no invariant was
 // violated and the heap did not grow beyond the run's own fault log, 1 otherwise, 2 on bad
 // arguments.
+#include <imd_version.hpp>
 #include <malloc.h>
 
 #include <CLI/CLI.hpp>
@@ -38,6 +39,7 @@ void operator delete(void* p, std::size_t) noexcept { operator delete(p); }
 int main(int argc, char** argv) {
   CLI::App app{"Soak: a long simulated run under a random host and random faults, with the "
                "invariants checked every tick."};
+  app.set_version_flag("--version", imd::version::kText);
   std::string scenario_file = std::string(IMD_SOURCE_DIR) + "/hal_sim/scenarios/seed000_can.toml";
   std::string law = "dsmc", precision = "double";
   double seconds = 60.0, brake_Nm = 5.0;
