@@ -1,7 +1,8 @@
 # Firmware images for Cortex-M4F targets.
 #
 # imd_add_cortex_m_image(NAME LINKER_SCRIPT script [TICK_ROOTS sym...] SOURCES src... LIBRARIES lib...)
-# links NAME.elf with the target's linker script and writes NAME.map and NAME.size.txt. The
+# links NAME.elf with the target's linker script and writes NAME.map, NAME.size.txt, and the
+# flashable NAME.bin (raw, from the first flash address) and NAME.hex (Intel HEX). The
 # link itself refuses exceptions: every throw entry point is wrapped (--wrap) and the wrappers
 # are never defined, so a reference fails with "undefined reference to `__wrap___cxa_throw'".
 # operator new is never defined either. The C allocator is wrapped to traps (there is no heap,
@@ -17,6 +18,7 @@ set(IMD_NO_HEAP_NO_EXCEPTIONS_WRAPS
     _Unwind_RaiseException)
 
 find_program(IMD_ARM_SIZE arm-none-eabi-size REQUIRED)
+find_program(IMD_ARM_OBJCOPY arm-none-eabi-objcopy REQUIRED)
 
 function(imd_add_cortex_m_image NAME)
   cmake_parse_arguments(ARG "" "LINKER_SCRIPT" "TICK_ROOTS;SOURCES;LIBRARIES" ${ARGN})
@@ -35,6 +37,18 @@ function(imd_add_cortex_m_image NAME)
   add_custom_command(TARGET ${NAME} POST_BUILD
     COMMAND ${IMD_ARM_SIZE} $<TARGET_FILE:${NAME}> > $<TARGET_FILE_DIR:${NAME}>/${NAME}.size.txt
     VERBATIM)
+  # The images a programmer takes, and a check that both hold the same bytes: the HEX read back
+  # as raw binary must equal the .bin (objcopy fills gaps alike in both).
+  set(base $<TARGET_FILE_DIR:${NAME}>/${NAME})
+  add_custom_command(TARGET ${NAME} POST_BUILD
+    COMMAND ${IMD_ARM_OBJCOPY} -O binary $<TARGET_FILE:${NAME}> ${base}.bin
+    COMMAND ${IMD_ARM_OBJCOPY} -O ihex $<TARGET_FILE:${NAME}> ${base}.hex
+    COMMAND ${IMD_ARM_OBJCOPY} -I ihex -O binary ${base}.hex ${base}.hex.bin
+    COMMAND ${CMAKE_COMMAND} -E compare_files ${base}.bin ${base}.hex.bin
+    COMMAND ${CMAKE_COMMAND} -E remove ${base}.hex.bin
+    BYPRODUCTS ${CMAKE_RUNTIME_OUTPUT_DIRECTORY}/${NAME}.bin
+               ${CMAKE_RUNTIME_OUTPUT_DIRECTORY}/${NAME}.hex
+    VERBATIM)
   if(ARG_TICK_ROOTS)
     set(roots "")
     foreach(root IN LISTS ARG_TICK_ROOTS)
@@ -47,4 +61,22 @@ function(imd_add_cortex_m_image NAME)
               --report $<TARGET_FILE_DIR:${NAME}>/${NAME}.tick_path.txt
       VERBATIM)
   endif()
+endfunction()
+
+# imd_add_flash_target(NAME IMAGE): `cmake --build --preset cortex-m4f --target NAME` programs
+# IMAGE's ELF into an STM32G4 over an ST-LINK with openocd, verifies it and resets the chip
+# (cmake/Flash.cmake; docs/flashing.md). openocd is looked for when flashing, not when
+# configuring, so installing it later needs no reconfiguration.
+set(IMD_OPENOCD_INTERFACE "interface/stlink.cfg" CACHE STRING
+    "openocd interface script of the flashing probe (docs/flashing.md)")
+set(IMD_OPENOCD_TARGET "target/stm32g4x.cfg" CACHE STRING "openocd target script of the MCU")
+function(imd_add_flash_target NAME IMAGE)
+  add_custom_target(${NAME}
+    COMMAND ${CMAKE_COMMAND} -DIMAGE=$<TARGET_FILE:${IMAGE}>
+            -DINTERFACE=${IMD_OPENOCD_INTERFACE} -DTARGET=${IMD_OPENOCD_TARGET}
+            -P ${PROJECT_SOURCE_DIR}/cmake/Flash.cmake
+    DEPENDS ${IMAGE}
+    USES_TERMINAL
+    COMMENT "Flashing ${IMAGE} with openocd (${IMD_OPENOCD_INTERFACE}, ${IMD_OPENOCD_TARGET})"
+    VERBATIM)
 endfunction()

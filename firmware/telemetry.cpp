@@ -1,5 +1,7 @@
 #include "firmware/telemetry.hpp"
 
+#include <imd_version.hpp>
+
 #include <algorithm>
 
 #include "firmware/protocol/frame_codec.hpp"
@@ -10,6 +12,19 @@ using protocol::encode_frame;
 using protocol::MessageId;
 
 constexpr uint8_t kNoIdentification = 6;  // kIdentifyStepValues' "none"
+
+/// A signal of the table by name; a typo fails to compile (an out-of-range index).
+constexpr const protocol::Signal& signal_of(MessageId id, const char* name) {
+  const protocol::Message& m = protocol::message(id);
+  return m.signals[static_cast<std::size_t>(protocol::find_signal(m, name))];
+}
+// Counts above 2^24 do not fit a float's mantissa: these are packed as raw bits.
+constexpr const protocol::Signal& kStateChangeTime = signal_of(MessageId::state_change, "time_ms");
+constexpr const protocol::Signal& kFirstFaultTime =
+    signal_of(MessageId::fault_report, "first_fault_time_ms");
+constexpr const protocol::Signal& kGitHash = signal_of(MessageId::version, "git_hash");
+static_assert(imd::version::kPatch <= signal_of(MessageId::version, "firmware_patch").raw_max(),
+              "the version frame carries the patch number in 7 bits");
 
 Telemetry::Telemetry(uint8_t node_id, uint32_t period_ns, int rate_Hz,
                      float ns_per_count) noexcept
@@ -50,6 +65,19 @@ uint32_t Telemetry::time_ms(uint64_t tick) const noexcept {
 }
 
 void Telemetry::send(hal::CanBus& can, const hal::CanFrame& frame) noexcept {
+  if (!version_sent_) {  // the first frame of a start: the version goes before it
+    version_sent_ = true;
+    send_version(can);
+  }
+  if (!can.try_send(frame)) ++dropped_;
+}
+
+void Telemetry::send_version(hal::CanBus& can) noexcept {
+  hal::CanFrame frame = encode_frame(
+      node_id_, MessageId::version,
+      {float(protocol::kProtocolVersion), float(imd::version::kMajor), float(imd::version::kMinor),
+       float(imd::version::kPatch), imd::version::kDirty ? 1.0f : 0.0f});
+  protocol::set_raw(frame.data, kGitHash, imd::version::kGitHash);
   if (!can.try_send(frame)) ++dropped_;
 }
 
@@ -120,7 +148,7 @@ void Telemetry::send_state_changes(hal::CanBus& can, const StateMachine& machine
           node_id_, MessageId::state_change,
           {float(t.from), float(t.to), float(t.reason), float((transitions_sent_ + 1) & 0xFF)});
       // Whole milliseconds exceed a float's 24-bit mantissa after 4.6 h: set the raw bits.
-      protocol::set_raw(frame.data, protocol::kStateChangeSignals[4], time_ms(t.tick));
+      protocol::set_raw(frame.data, kStateChangeTime, time_ms(t.tick));
       send(can, frame);
     }
     ++transitions_sent_;  // a transition that fell out of the log is skipped
@@ -129,20 +157,22 @@ void Telemetry::send_state_changes(hal::CanBus& can, const StateMachine& machine
 
 void Telemetry::send_heartbeat(hal::CanBus& can, const DriveStatus& status,
                                const StateMachine& machine) noexcept {
-  send(can, encode_frame(node_id_, MessageId::heartbeat,
-                         {float(status.state), float(status.fault_bits), float(status.first_fault),
-                          float(heartbeat_count_++), float(status.command_counter),
-                          float(status.controller), status.can_bus_off ? 1.0f : 0.0f,
-                          float(status.rejected_commands & 0x3F), float(status.limited),
-                          float(machine.count() & 0xFF), float(status.stop),
-                          status.brake_engaged ? 1.0f : 0.0f, float(status.reset_cause)}));
+  hal::CanFrame frame = encode_frame(
+      node_id_, MessageId::heartbeat,
+      {float(status.state), float(status.first_fault), float(heartbeat_count_++),
+       float(status.command_counter), float(status.controller), status.can_bus_off ? 1.0f : 0.0f,
+       float(status.rejected_commands & 0x3F), float(status.limited),
+       float(machine.count() & 0xFF), float(status.stop), status.brake_engaged ? 1.0f : 0.0f,
+       float(status.reset_cause)});
+  protocol::set_fault_bits(frame.data, protocol::kHeartbeatFaultWordBit, status.fault_bits);
+  send(can, frame);
 }
 
 void Telemetry::report_fault(hal::CanBus& can, const DriveStatus& status) noexcept {
-  hal::CanFrame frame = encode_frame(
-      node_id_, MessageId::fault_report,
-      {float(status.first_fault), float(status.fault_bits), 0.0f, float(status.fault_detail)});
-  protocol::set_raw(frame.data, protocol::kFaultReportSignals[2], time_ms(status.first_fault_tick));
+  hal::CanFrame frame = encode_frame(node_id_, MessageId::fault_report,
+                                     {float(status.first_fault), 0.0f, float(status.fault_detail)});
+  protocol::set_raw(frame.data, kFirstFaultTime, time_ms(status.first_fault_tick));
+  protocol::set_fault_bits(frame.data, protocol::kFaultReportFaultWordBit, status.fault_bits);
   send(can, frame);
 }
 

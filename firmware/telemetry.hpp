@@ -1,7 +1,8 @@
 #pragma once
 /// What the drive sends on CAN, and when (docs/can/protocol.md): the heartbeat and the timing
 /// frame at 10 Hz, fast telemetry at a configurable 10..1000 Hz (three frames per sample, the
-/// voltage frame last), and event frames for state changes, faults and command results.
+/// voltage frame last), and event frames for state changes, faults and command results. The
+/// version frame goes first, once per start, before whatever frame the drive sends first.
 /// Frames go to the HAL's non-blocking transmit queue; a full queue drops the frame and counts
 /// it. Tick context, no heap.
 #include <cstdint>
@@ -72,6 +73,7 @@ class Telemetry {
 
  private:
   void send(hal::CanBus& can, const hal::CanFrame& frame) noexcept;
+  void send_version(hal::CanBus& can) noexcept;
   void send_state_changes(hal::CanBus& can, const StateMachine& machine) noexcept;
   void send_heartbeat(hal::CanBus& can, const DriveStatus& status,
                       const StateMachine& machine) noexcept;
@@ -91,6 +93,7 @@ class Telemetry {
   uint8_t sample_count_ = 0;
   uint32_t transitions_sent_ = 0;
   uint32_t dropped_ = 0;
+  bool version_sent_ = false;
 };
 
 }  // namespace imd::firmware

@@ -33,15 +33,17 @@ const char* type_name(const toml::node& node) {
   }
 }
 
-/// Where a key is, for messages: the file and the table ("motor" or "plant").
+/// Where a key is, for messages: the file (or flag) each key came from, and the table ("motor"
+/// or "plant").
 struct Place {
-  std::string_view source, table;
+  const MotorKeyOrigin& origin_of;
+  std::string_view table;
 };
 
 const toml::node& require_key(const toml::table& motor, std::string_view key, Place at) {
   const toml::node* node = motor.get(key);
   if (node == nullptr) {
-    throw ConfigError(fmt::format("{}: missing key {}.{}", at.source, at.table, key));
+    throw ConfigError(fmt::format("{}: missing key {}.{}", at.origin_of(key), at.table, key));
   }
   return *node;
 }
@@ -50,8 +52,8 @@ double require_number(const toml::table& motor, std::string_view key, Place at) 
   const toml::node& node = require_key(motor, key, at);
   if (const auto* real = node.as_floating_point()) return real->get();
   if (const auto* integer = node.as_integer()) return static_cast<double>(integer->get());
-  throw ConfigError(fmt::format("{}: {}.{} must be a number, got {}", at.source, at.table, key,
-                                type_name(node)));
+  throw ConfigError(fmt::format("{}: {}.{} must be a number, got {}", at.origin_of(key), at.table,
+                                key, type_name(node)));
 }
 
 int require_integer(const toml::table& motor, std::string_view key, Place at) {
@@ -59,13 +61,19 @@ int require_integer(const toml::table& motor, std::string_view key, Place at) {
   if (const auto* integer = node.as_integer()) {
     const int64_t value = integer->get();
     if (value < 1 || value > 64) {
-      throw ConfigError(fmt::format("{}: {}.{} = {}: must be an integer in 1..64", at.source,
-                                    at.table, key, value));
+      throw ConfigError(fmt::format("{}: {}.{} = {}: must be an integer in 1..64",
+                                    at.origin_of(key), at.table, key, value));
     }
     return static_cast<int>(value);
   }
-  throw ConfigError(fmt::format("{}: {}.{} must be an integer, got {}", at.source, at.table, key,
-                                type_name(node)));
+  if (const auto* real = node.as_floating_point()) {  // 2.5 pole pairs; 2.0 too, as TOML types it
+    std::string shown = fmt::format("{}", real->get());
+    if (shown.find_first_of(".eEn") == std::string::npos) shown += ".0";
+    throw ConfigError(fmt::format("{}: {}.{} = {}: must be an integer", at.origin_of(key),
+                                  at.table, key, shown));
+  }
+  throw ConfigError(fmt::format("{}: {}.{} must be an integer, got {}", at.origin_of(key),
+                                at.table, key, type_name(node)));
 }
 
 }  // namespace
@@ -89,16 +97,23 @@ toml::table parse_toml_file(const std::filesystem::path& path) {
 
 control::MotorParameters parse_motor_table(const toml::table& document, std::string_view source,
                                            std::string_view table) {
+  return parse_motor_table(
+      document, [source](std::string_view) { return std::string(source); }, table);
+}
+
+control::MotorParameters parse_motor_table(const toml::table& document,
+                                           const MotorKeyOrigin& origin_of,
+                                           std::string_view table) {
   const toml::node* motor_node = document.get(table);
   if (motor_node == nullptr) {
-    throw ConfigError(fmt::format("{}: missing table [{}]", source, table));
+    throw ConfigError(fmt::format("{}: missing table [{}]", origin_of(""), table));
   }
   const toml::table* motor = motor_node->as_table();
   if (motor == nullptr) {
-    throw ConfigError(
-        fmt::format("{}: {} must be a table, got {}", source, table, type_name(*motor_node)));
+    throw ConfigError(fmt::format("{}: {} must be a table, got {}", origin_of(""), table,
+                                  type_name(*motor_node)));
   }
-  const Place at{source, table};
+  const Place at{origin_of, table};
   control::MotorParameters p;
   p.Rs_Ohm = require_number(*motor, "Rs_Ohm", at);
   p.Ls_H = require_number(*motor, "Ls_H", at);
@@ -109,8 +124,8 @@ control::MotorParameters parse_motor_table(const toml::table& document, std::str
   p.pole_pairs = require_integer(*motor, "pole_pairs", at);
   p.friction_Nms = require_number(*motor, "friction_Nms", at);
   if (const auto problem = control::find_invalid_parameter(p)) {
-    throw ConfigError(fmt::format("{}: {}.{} = {}: {}", source, table, problem->key,
-                                  problem->value, problem->rule));
+    throw ConfigError(fmt::format("{}: {}.{} = {}: {}", origin_of(problem->key), table,
+                                  problem->key, problem->value, problem->rule));
   }
   return p;
 }

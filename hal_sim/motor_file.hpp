@@ -8,6 +8,7 @@
 /// All eight keys are required; other keys in the table are free (names, ratings). Host only.
 #include <toml++/toml.h>
 #include <filesystem>
+#include <functional>
 #include <string>
 #include <string_view>
 
@@ -23,6 +24,15 @@ control::MotorParameters load_motor_file(const std::filesystem::path& path);
 /// completed [plant]) of an already parsed document. `source` names the document in error
 /// messages.
 control::MotorParameters parse_motor_table(const toml::table& document, std::string_view source,
+                                           std::string_view table = "motor");
+
+/// Names, for messages, the file or flag a key of the table came from ("" for the table
+/// itself): a scenario's [motor] may come from a motor file, its keys from --set overrides.
+using MotorKeyOrigin = std::function<std::string(std::string_view key)>;
+
+/// parse_motor_table, each message naming the origin of the key it is about.
+control::MotorParameters parse_motor_table(const toml::table& document,
+                                           const MotorKeyOrigin& origin_of,
                                            std::string_view table = "motor");
 
 /// The text of a motor file that load_motor_file reads back exactly (every value to 17

@@ -12,61 +12,19 @@
 
 #include "hal_sim/config_error.hpp"
 #include "hal_sim/motor_file.hpp"
+#include "hal_sim/scenario_document.hpp"
 #include "hal_sim/scenario_reader.hpp"
 
 namespace imd::sim {
 
 namespace {
 
+using detail::KeyOrigins;
+using detail::kMotorKeys;
 using detail::Reader;
 
-const std::set<std::string> kMotorKeys = {"Rs_Ohm", "Ls_H",   "Lm_H",       "Rr_Ohm",
-                                          "Lr_H",   "J_kgm2", "pole_pairs", "friction_Nms"};
 /// [plant] keys that are not the motor's: its resistances' drift over the run.
 const std::set<std::string> kDriftKeys = {"Rs_scale_end", "Rr_scale_end"};
-
-/// Parses VALUE as a TOML value; a bare word that is not TOML becomes a string.
-toml::table parse_override_value(const std::string& text) {
-  try {
-    return toml::parse("value = " + text);
-  } catch (const toml::parse_error&) {
-    toml::table table;
-    table.insert("value", text);
-    return table;
-  }
-}
-
-void apply_override(toml::table& doc, const std::string& assignment, const std::string& source) {
-  const auto equals = assignment.find('=');
-  if (equals == std::string::npos || equals == 0) {
-    throw ConfigError(fmt::format("--set {}: expected table.key=VALUE", assignment));
-  }
-  const std::string path = assignment.substr(0, equals);
-  const std::string text = assignment.substr(equals + 1);
-  std::vector<std::string> parts;
-  std::stringstream stream(path);
-  for (std::string part; std::getline(stream, part, '.');) parts.push_back(part);
-  if (parts.size() < 2)
-    throw ConfigError(fmt::format("--set {}: expected table.key=VALUE", assignment));
-  // The motor table admits free keys, so an override there must name a contract key or one
-  // the file has: a typo must not pass silently.
-  if (parts[0] == "motor" && !kMotorKeys.count(parts[1]) && !doc.at_path(path)) {
-    throw ConfigError(fmt::format("{}: --set {}: unknown key", source, path));
-  }
-  toml::table* table = &doc;
-  for (std::size_t i = 0; i + 1 < parts.size(); ++i) {
-    toml::node* child = table->get(parts[i]);
-    if (child == nullptr) {
-      table->insert(parts[i], toml::table{});
-      child = table->get(parts[i]);
-    }
-    table = child->as_table();
-    if (table == nullptr)
-      throw ConfigError(fmt::format("{}: --set {}: {} is not a table", source, path, parts[i]));
-  }
-  toml::table parsed = parse_override_value(text);
-  table->insert_or_assign(parts.back(), std::move(*parsed.get("value")));
-}
 
 /// A steps table: times in increasing order, one value per time, at most N steps (the profiles
 /// hold them in fixed storage). Returns the number of steps.
@@ -123,90 +81,54 @@ void read_load_like(Reader& r, const std::string& prefix, LoadProfile& p) {
   }
 }
 
-/// The [motor] table of the motor file `file` names (relative to the scenario's directory).
-toml::table motor_table_of(const std::filesystem::path& scenario, const toml::node& file,
-                           const std::string& key) {
-  const auto* name = file.as_string();
-  if (name == nullptr) {
-    throw ConfigError(fmt::format("{}: {} must be a string", scenario.string(), key));
-  }
-  const std::filesystem::path motor_path = scenario.parent_path() / name->get();
-  const toml::table motor_doc = parse_toml_file(motor_path);
-  const toml::node* motor = motor_doc.get("motor");
-  if (motor == nullptr || !motor->is_table()) {
-    throw ConfigError(fmt::format("{}: missing table [motor]", motor_path.string()));
-  }
-  return *motor->as_table();
-}
-
 /// The simulated motor: [plant] motor_file, or else [motor], with the keys [plant] changes (any
 /// motor key, nothing else). `base`: the plant's motor when it is not [motor].
-control::MotorParameters parse_plant_table(const toml::table& doc, const std::string& source,
+control::MotorParameters parse_plant_table(const toml::table& doc, const KeyOrigins& origins,
                                            const std::optional<toml::table>& base) {
+  const auto origin_of = [&](const std::string& table) {
+    return [&origins, table](std::string_view key) {
+      return origins.of(key.empty() ? table : table + "." + std::string(key));
+    };
+  };
   const toml::node* plant = doc.get("plant");
-  if (plant == nullptr && !base) return parse_motor_table(doc, source);
+  if (plant == nullptr && !base) return parse_motor_table(doc, origin_of("motor"));
   if (plant != nullptr && !plant->is_table()) {
-    throw ConfigError(fmt::format("{}: plant must be a table", source));
+    throw ConfigError(fmt::format("{}: plant must be a table", origins.of("plant")));
   }
   toml::table completed = base ? *base : *doc.get("motor")->as_table();  // checked
   const toml::table changes = plant != nullptr ? *plant->as_table() : toml::table{};
   for (auto&& [key, value] : changes) {
     if (kDriftKeys.count(std::string(key.str()))) continue;  // not the motor's: the run's
     if (!kMotorKeys.count(std::string(key.str())) && key.str() != "name") {
+      const std::string path = "plant." + std::string(key.str());
       throw ConfigError(
-          fmt::format("{}: unknown key plant.{} (a motor key: Rs_Ohm, Ls_H, Lm_H, "
+          fmt::format("{}: unknown key {} (a motor key: Rs_Ohm, Ls_H, Lm_H, "
                       "Rr_Ohm, Lr_H, J_kgm2, pole_pairs, friction_Nms; or Rr_scale_end, "
                       "Rs_scale_end)",
-                      source, key.str()));
+                      origins.of(path), path));
     }
     completed.insert_or_assign(key, value);
   }
   toml::table holder;
   holder.insert("plant", std::move(completed));
-  return parse_motor_table(holder, source, "plant");
+  return parse_motor_table(holder, origin_of("plant"), "plant");
 }
 
 }  // namespace
 
 Scenario load_scenario(const std::filesystem::path& path, const std::vector<std::string>& overrides,
                        const std::optional<std::filesystem::path>& model_file) {
-  toml::table doc = parse_toml_file(path);
-  const std::string source = path.string();
-  if (const toml::node* motor_file = doc.get("motor_file")) {
-    if (doc.get("motor") != nullptr) {
-      throw ConfigError(fmt::format("{}: give either motor_file or [motor], not both", source));
-    }
-    doc.insert("motor", motor_table_of(path, *motor_file, "motor_file"));
-    doc.erase("motor_file");
-  }
-  // model_file: the controller's motor from the file, the plant stays the scenario's motor;
-  // before the overrides, so that motor.* changes the controller's and plant.* the plant's.
-  std::optional<toml::table> scenario_motor;
-  if (model_file) {
-    if (doc.get("motor") != nullptr) scenario_motor = *doc.get("motor")->as_table();
-    const toml::table model_doc = parse_toml_file(*model_file);
-    (void)parse_motor_table(model_doc, model_file->string());  // its own errors, its own name
-    doc.insert_or_assign("motor", *model_doc.get("motor")->as_table());
-  }
-  for (const std::string& assignment : overrides) apply_override(doc, assignment, source);
-  // [plant] motor_file: the simulated motor starts from that file instead of [motor].
-  std::optional<toml::table> plant_base = scenario_motor;
-  if (toml::table* plant = doc["plant"].as_table()) {
-    if (const toml::node* file = plant->get("motor_file")) {
-      plant_base = motor_table_of(path, *file, "plant.motor_file");
-      plant->erase("motor_file");
-    }
-  }
-  // A commissioning run gives the drive no motor: without [motor], the plant's stands for it.
-  if (doc.get("motor") == nullptr && plant_base && doc.get("nameplate") != nullptr) {
-    doc.insert("motor", *plant_base);
-  }
+  const detail::ScenarioDocument document = detail::assemble_scenario(path, overrides, model_file);
+  const toml::table& doc = document.doc;
+  const KeyOrigins& origins = document.origins;
 
   Scenario s;
-  s.source = source;
-  s.motor = parse_motor_table(doc, source);
-  s.plant = parse_plant_table(doc, source, plant_base);
-  Reader r(doc, source);
+  s.source = path.string();
+  s.motor = parse_motor_table(doc, [&](std::string_view key) {
+    return origins.of(key.empty() ? std::string("motor") : "motor." + std::string(key));
+  });
+  s.plant = parse_plant_table(doc, origins, document.plant_base);
+  Reader r(doc, origins);
   r.accept_table("motor");
   r.accept_table("plant");
 

@@ -157,7 +157,7 @@ struct Scenario {
 
   // [can]
   int can_node_id = 1;             ///< 0..63
-  double telemetry_rate_Hz = 100;  ///< fast telemetry, 10..1000
+  int telemetry_rate_Hz = 100;  ///< fast telemetry, 10..1000, whole hertz
 
   ProtectionSettings protection;               ///< [protection]
   std::vector<FaultInjection> faults;          ///< [[faults]], sorted by at_s (stable)
@@ -168,8 +168,9 @@ struct Scenario {
 /// Loads a scenario. `overrides` are "table.key=VALUE" strings (VALUE in TOML syntax; a bare
 /// word is taken as a string), applied after any motor_file has been merged in. `model_file`:
 /// a motor file the controller is given instead of the scenario's motor, which stays the
-/// simulated one (an identified motor on the true plant). Throws ConfigError naming the file,
-/// the key and the value.
+/// simulated one (an identified motor on the true plant). Throws ConfigError naming the file
+/// that holds the key (the scenario, a motor file it names, `model_file`) or the override that
+/// set it ("--set table.key=VALUE"), then the key and the value.
 Scenario load_scenario(const std::filesystem::path& path,
                        const std::vector<std::string>& overrides = {},
                        const std::optional<std::filesystem::path>& model_file = std::nullopt);

@@ -180,11 +180,8 @@ void read_can_commands(Reader& r, Scenario& s) {
 
 void read_can(Reader& r, Scenario& s) {
   s.can_node_id = static_cast<int>(r.integer("can.node_id", 1, 0, 63));
-  s.telemetry_rate_Hz = r.number("can.telemetry_rate_Hz", 100.0);
-  if (!(s.telemetry_rate_Hz >= 10.0 && s.telemetry_rate_Hz <= 1000.0)) {
-    r.fail("can.telemetry_rate_Hz",
-           fmt::format("= {}: must be in [10, 1000] Hz", s.telemetry_rate_Hz));
-  }
+  // Whole hertz, as the drive holds it (firmware DriveConfig, the set_telemetry_rate command).
+  s.telemetry_rate_Hz = static_cast<int>(r.integer("can.telemetry_rate_Hz", 100, 10, 1000));
 }
 
 void read_protection(Reader& r, Scenario& s) {

@@ -1,7 +1,7 @@
 #pragma once
 /// The scenario loader's reader (internal to hal_sim/scenario*.cpp): typed, validated access to
-/// the keys of a TOML document by dotted path, with messages that name the file, the key and
-/// the value, and a final check that every key of the document was read.
+/// the keys of a TOML document by dotted path, with messages that name the file or flag the key
+/// came from, the key and the value, and a final check that every key of the document was read.
 #include <fmt/format.h>
 #include <toml++/toml.h>
 
@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "hal_sim/config_error.hpp"
+#include "hal_sim/scenario_origins.hpp"
 
 namespace imd::sim {
 struct Scenario;
@@ -30,10 +31,11 @@ namespace imd::sim::detail {
 /// document can be reported as unknown.
 class Reader {
  public:
-  Reader(const toml::table& doc, std::string source) : doc_(doc), source_(std::move(source)) {}
+  /// `origins` must outlive the reader.
+  Reader(const toml::table& doc, const KeyOrigins& origins) : doc_(doc), origins_(origins) {}
 
   [[noreturn]] void fail(std::string_view path, const std::string& what) const {
-    throw ConfigError(fmt::format("{}: {}: {}", source_, path, what));
+    throw ConfigError(fmt::format("{}: {}: {}", origins_.of(path), path, what));
   }
 
   /// Whether the document has the key (without marking it read).
@@ -85,6 +87,9 @@ class Reader {
     const toml::node* node = find(path);
     if (node == nullptr) return fallback;
     const auto* value = node->as_integer();
+    if (value == nullptr && node->is_floating_point()) {  // 2.5; 2.0 too, as TOML types it
+      fail(path, fmt::format("= {}: must be an integer", text(*node)));
+    }
     if (value == nullptr) fail(path, "must be an integer");
     if (value->get() < low || value->get() > high) {
       fail(path, fmt::format("= {}: must be in {}..{}", value->get(), low, high));
@@ -164,7 +169,7 @@ class Reader {
     }
   }
   [[noreturn]] void unknown_key(std::string_view path) const {
-    throw ConfigError(fmt::format("{}: unknown key {}", source_, path));
+    throw ConfigError(fmt::format("{}: unknown key {}", origins_.of(path), path));
   }
   /// A value as TOML writes it (strings in double quotes), for messages.
   static std::string text(const toml::node& node) {
@@ -195,7 +200,7 @@ class Reader {
   }
 
   const toml::table& doc_;
-  std::string source_;
+  const KeyOrigins& origins_;
   std::set<std::string> read_, accepted_;
 };
 

@@ -1,11 +1,17 @@
 # The host CAN tools: candump -L logs (tools/can_log), SocketCAN (hal/linux) and drive_monitor.
 # Test names contain can_log, socketcan or monitor; all are in the unit tier.
-imd_add_test(test_can_log unit LIBRARIES imd_can_log SOURCES tools/test_can_log.cpp)
+imd_add_test(test_can_log unit LIBRARIES imd_can_log
+             SOURCES tools/test_can_log.cpp tools/test_can_log_kinds.cpp)
 imd_add_test(test_drive_monitor unit LIBRARIES imd_drive_monitor SOURCES tools/test_drive_monitor.cpp)
 imd_add_test(test_drive_monitor_repeat unit LIBRARIES imd_drive_monitor
              SOURCES tools/test_drive_monitor_repeat.cpp)
 imd_add_test(test_drive_monitor_parameters unit LIBRARIES imd_drive_monitor
              SOURCES tools/test_drive_monitor_parameters.cpp)
+imd_add_test(test_drive_monitor_capture unit LIBRARIES imd_drive_monitor
+             SOURCES tools/test_drive_monitor_capture.cpp)
+# drive_sim --can-log's two directions, on a short run of the CAN scenario.
+imd_add_test(test_can_log_host_frames sim LIBRARIES imd_can_log imd_sim_drive
+             SOURCES tools/test_can_log_host_frames.cpp)
 
 # drive_monitor: exit code 2 and a clear message on bad input (the interface is checked on a
 # machine that may have no CAN at all: either message is clear), decoding of a recorded log.
@@ -29,9 +35,29 @@ if(TARGET drive_monitor)
   imd_monitor_test(drive_monitor_bad_log_line 2
                    "drive_monitor: .*/bad_line.log:3: data '0801000' has an odd number of hex digits"
                    watch --log ${CAN_DATA}/bad_line.log)
-  imd_monitor_test(drive_monitor_extended_id 2
-                   "extended_id.log:2: extended identifier '18FF0001' \\(29 bits\\): not supported"
+  imd_monitor_test(drive_monitor_extended_id 0
+                   "2 frames: 1 decoded .*skipped: 0 error frames, 1 with 29-bit ids,"
                    watch --log ${CAN_DATA}/extended_id.log)
+  # A capture of a shared bus (candump -L -x): node 1's frames decode as from a clean log, the
+  # rest is counted; shared_bus.log holds monitor_sample.log's frames and the others. ('.' in
+  # the patterns stands for ';', which CMake would take for a list separator.)
+  imd_monitor_test(drive_monitor_shared_bus 0
+                   "47 frames: 30 decoded \\(26 from node 1, 4 commands to it\\). skipped: 3 error frames, 3 with 29-bit ids, 2 CAN FD, 2 remote, 6 of other nodes \\(node 2: 6\\), 1 of unknown messages, 0 of wrong length. the capture lost 2 frames"
+                   watch --log ${CAN_DATA}/shared_bus.log)
+  imd_monitor_test(drive_monitor_shared_bus_csv 0
+                   "^1700000000\\.130300,37\\.02,100\\.00,0\\.8099,0\\.8100,4\\.50,-2\\.25,0\\.50,301\\.7,30\\.3,-20\\.2,1\\.0000,3,running,none$"
+                   watch --log ${CAN_DATA}/shared_bus.log --csv - --no-table)
+  imd_monitor_test(drive_monitor_other_node_only 4
+                   "warning: no frame from node 1 on .*node2_only.log. heard only other nodes \\(node 2: 7\\): is --node right\\?"
+                   watch --log ${CAN_DATA}/node2_only.log --no-table)
+  imd_monitor_test(drive_monitor_other_node_watched 0 "8 frames: 7 decoded \\(6 from node 2, 1 commands to it\\)"
+                   watch --log ${CAN_DATA}/node2_only.log --node 2 --no-table)
+  imd_monitor_test(drive_monitor_bad_dropcount_line 2
+                   "drive_monitor: .*/bad_dropcount.log:2: bad DROPCOUNT line 'DROPCOUNT: dropped 2 CAN frames on can0 socket"
+                   watch --log ${CAN_DATA}/bad_dropcount.log)
+  imd_monitor_test(drive_monitor_bad_fd_line 2
+                   "drive_monitor: .*/bad_fd_line.log:2: CAN FD data '00112233445566778899' has 10 bytes"
+                   watch --log ${CAN_DATA}/bad_fd_line.log)
   imd_monitor_test(drive_monitor_log_table 0
                    "last ack +set_speed counter 3: accepted, rejected_total 1"
                    watch --log ${CAN_DATA}/monitor_sample.log)

@@ -40,6 +40,14 @@ foreach(arch x86_64 aarch64)
   set_tests_properties(qemu_hil_${arch} PROPERTIES LABELS qemu RUN_SERIAL ON TIMEOUT 400)
 endforeach()
 
+# The Python client (tools/python) commanding drive_hil over vcan0 in the x86_64 guest, with
+# the host's interpreter and python3-can shipped into it (tests/qemu/python_test.py).
+add_test(NAME qemu_python_client
+         COMMAND /usr/bin/python3 -B ${CMAKE_CURRENT_SOURCE_DIR}/qemu/python_test.py
+                 --bin-dir ${CMAKE_BINARY_DIR}/qemu-x86_64/bin --source-dir ${PROJECT_SOURCE_DIR}
+                 --cache ${IMD_QEMU_CACHE} --work ${CMAKE_BINARY_DIR}/qemu-work-python)
+set_tests_properties(qemu_python_client PROPERTIES LABELS qemu RUN_SERIAL ON TIMEOUT 300)
+
 # Processor in the loop: the Cortex-M4F image on QEMU's mps2-an386 (tests/qemu/pil_test.py),
 # built with the bare-metal toolchain in its own tree, like the cortex-m4f preset.
 find_program(IMD_ARM_NONE_EABI_CXX arm-none-eabi-g++)

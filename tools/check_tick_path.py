@@ -39,6 +39,8 @@ import struct
 import subprocess
 import sys
 
+import imd_version
+
 DEFAULT_DENY = [
     r'^__aeabi_(d|f2d|i2d|ui2d|l2d|ul2d)',  # double soft-float, run-time ABI names
     r'^__(add|sub|mul|div|neg)df3$',
@@ -259,6 +261,7 @@ def main(argv=None):
                          'names, the object holding the entry point and those following it')
     ap.add_argument('--report', metavar='FILE', help='write the reachable functions and sizes')
     ap.add_argument('--objdump', default='arm-none-eabi-objdump')
+    imd_version.add_argument(ap)
     args = ap.parse_args(argv)
     try:
         if not os.path.isfile(args.elf):

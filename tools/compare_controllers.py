@@ -29,6 +29,8 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
+import imd_version  # noqa: E402
+
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 BASE = ROOT / "hal_sim/scenarios/seed000_realistic.toml"
 LAWS = ["dsmc", "iol", "ifoc"]
@@ -315,6 +317,7 @@ def main():
     parser.add_argument("--work", required=True, type=pathlib.Path)
     parser.add_argument("--pil-elf", type=pathlib.Path)
     parser.add_argument("--results", type=pathlib.Path, default=ROOT / "docs/results.md")
+    imd_version.add_argument(parser)
     args = parser.parse_args()
     args.work.mkdir(parents=True, exist_ok=True)
     motor_doc = tomllib.loads((BASE.parent / tomllib.loads(BASE.read_text())["motor_file"])

@@ -20,6 +20,8 @@ import pathlib
 import subprocess
 import sys
 
+import imd_version
+
 SKIP = {"seed000_hil"}  # the real-time scenario: CAN-commanded, no profile to run here
 NOT_COMPARED = {"wall_time_s", "tick_exec_ns_mean", "tick_exec_ns_max", "realtime_factor",
                 "stage_ns", "scenario", "source", "controller", "motor", "plant",
@@ -120,6 +122,7 @@ def main():
     c.add_argument("before")
     c.add_argument("after")
     c.add_argument("--markdown", action="store_true")
+    imd_version.add_argument(parser)
     args = parser.parse_args()
     if args.command == "run":
         run(args)

@@ -18,6 +18,8 @@ import sys
 import tempfile
 from pathlib import Path
 
+import imd_version
+
 ROOT = Path(__file__).resolve().parent.parent
 
 
@@ -76,6 +78,7 @@ def main():
     parser.add_argument("--duration-s", type=int, default=60)
     parser.add_argument("--period-us", type=int, default=100)
     parser.add_argument("--priority", type=int, default=80)
+    imd_version.add_argument(parser)
     args = parser.parse_args()
     with tempfile.TemporaryDirectory() as tmp:
         hil = run_drive_hil(args, Path(tmp) / "report.json")

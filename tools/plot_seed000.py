@@ -1,10 +1,12 @@
 #!/usr/bin/python3
 """Regenerates Figures 1-5 of paper 000 (Section V) from a drive_sim CSV.
 
-    plot_seed000.py RUN.csv --out FIGURES.png [--separate DIR] [--settle-s S]
+    plot_seed000.py RUN.csv --out FIGURES.png [--separate DIR] [--settle-s S] [--title TEXT]
 
-FIGURES.png holds all five figures as panels; --separate also writes fig1.png .. fig5.png.
-Needs Debian's python3-matplotlib and python3-numpy.
+FIGURES.png (or .pdf, .svg) holds all five figures as panels; --separate also writes fig1.png
+.. fig5.png. The drive's states other than running are shaded (plot_states.py). --title names
+the run (drive_sim gives the scenario); the CSV's file name by default. Needs Debian's
+python3-matplotlib and python3-numpy.
 """
 import argparse
 import os
@@ -16,6 +18,9 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
+import imd_version  # noqa: E402
+import plot_states  # noqa: E402
+
 
 def load(path):
     data = np.genfromtxt(path, delimiter=",", names=True)
@@ -24,8 +29,7 @@ def load(path):
     return data
 
 
-# The drive state numbers of firmware/drive_state.hpp (the CAN protocol's).
-RUNNING = 3
+RUNNING = plot_states.RUNNING
 
 
 def running_start(d):
@@ -92,11 +96,14 @@ def fig5(axes, d):
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("csv")
-    parser.add_argument("--out", required=True, help="PNG with all five figures")
+    parser.add_argument("--out", required=True, help="PNG (or PDF, SVG) with all five figures")
     parser.add_argument("--separate", help="directory for fig1.png .. fig5.png")
     parser.add_argument("--settle-s", type=float, default=0.0, help="marked on the time axes")
+    parser.add_argument("--title", help="the run's name (default: the CSV's file name)")
+    imd_version.add_argument(parser)
     args = parser.parse_args()
     d = load(args.csv)
+    runs = plot_states.spans(d)
 
     fig, grid = plt.subplots(4, 2, figsize=(14, 16))
     fig1(grid[0], d)
@@ -106,8 +113,10 @@ def main():
     fig5(grid[3], d)
     for ax in grid.flat:
         ax.grid(True, alpha=0.3)
-    fig.suptitle(os.path.basename(args.csv))
-    fig.tight_layout()
+        plot_states.shade(ax, runs)
+    fig.suptitle(args.title or os.path.basename(args.csv))
+    plot_states.legend(fig, runs)
+    fig.tight_layout(rect=(0, 0, 1, 0.97))  # room for the title and the states' legend
     fig.savefig(args.out, dpi=90)
 
     if args.separate:
@@ -117,6 +126,8 @@ def main():
             draw(axes, d)
             for ax in np.atleast_1d(axes):
                 ax.grid(True, alpha=0.3)
+                plot_states.shade(ax, runs)
+            single.suptitle(args.title or os.path.basename(args.csv))
             single.tight_layout()
             single.savefig(os.path.join(args.separate, f"fig{number}.png"), dpi=90)
             plt.close(single)

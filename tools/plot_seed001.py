@@ -1,11 +1,13 @@
 #!/usr/bin/python3
 """Regenerates Figures 3 and 4 of paper 001 (Section 5) from a drive_sim CSV of an iol run.
 
-    plot_seed001.py RUN.csv --out FIGURES.png [--settle-s S]
+    plot_seed001.py RUN.csv --out FIGURES.png [--settle-s S] [--title TEXT]
 
 Panels: torque and its reference v1, the second output y2 and its reference v2, the squared
 stator flux and its target, and the speed. Values are taken at the T0 boundaries, where the
-law acts (held in between, as the paper shows them). Needs Debian's python3-matplotlib.
+law acts (held in between, as the paper shows them). The drive's states other than running are
+shaded (plot_states.py). --title names the run (drive_sim gives the scenario); the CSV's file
+name by default. Needs Debian's python3-matplotlib.
 """
 import argparse
 import os
@@ -17,12 +19,17 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
+import imd_version  # noqa: E402
+import plot_states  # noqa: E402
+
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("csv")
     parser.add_argument("--out", required=True)
     parser.add_argument("--settle-s", type=float, default=0.0)
+    parser.add_argument("--title", help="the run's name (default: the CSV's file name)")
+    imd_version.add_argument(parser)
     args = parser.parse_args()
     d = np.genfromtxt(args.csv, delimiter=",", names=True)
     boundary = np.nonzero(d["iol_boundary"] > 0)[0]
@@ -57,10 +64,13 @@ def main():
     ax2.set_ylabel("load [N m]")
     ax.set(title="speed and load", xlabel="t [s]", ylabel="speed [rad/s]")
     ax.legend(loc="upper left")
+    runs = plot_states.spans(d)
     for a in grid.flat:
         a.grid(True, alpha=0.3)
-    fig.suptitle(os.path.basename(args.csv))
-    fig.tight_layout()
+        plot_states.shade(a, runs)
+    fig.suptitle(args.title or os.path.basename(args.csv))
+    plot_states.legend(fig, runs)
+    fig.tight_layout(rect=(0, 0, 1, 0.96))  # room for the title and the states' legend
     fig.savefig(args.out, dpi=90)
 
 

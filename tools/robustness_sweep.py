@@ -35,6 +35,8 @@ import sys
 import tempfile
 import tomllib
 
+import imd_version
+
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 LAWS = {  # law: (scenario, duration_s, settle_s)
     "dsmc": ("hal_sim/scenarios/seed000_realistic.toml", 8.0, 0.5),
@@ -201,6 +203,7 @@ def main():
     p.add_argument("--quick", action="store_true",
                    help="3 x 3 ratios per map (the corners, the edges' middles and the centre): "
                    "a smoke test")
+    imd_version.add_argument(p)
     a = p.parse_args()
     if a.out is None:
         a.out = "/tmp/robustness_quick" if a.quick else str(ROOT / "docs/img")

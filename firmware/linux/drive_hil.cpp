@@ -44,6 +44,7 @@
 #include "firmware/parameters/motor_record.hpp"
 #include "hal/linux/file_parameter_store.hpp"
 #include "hal/linux/gpiod_lines.hpp"
+#include "hal/linux/can_bit_rate.hpp"
 #include "hal/linux/queued_can_bus.hpp"
 #include "hal/linux/realtime_timer.hpp"
 #include "hal_sim/config_error.hpp"
@@ -56,6 +57,13 @@ namespace {
 
 constexpr int kExitFailed = 1;
 constexpr int kExitBadInput = 2;
+/// The protocol's one bit rate: a real CAN interface must be configured for it.
+constexpr uint32_t kBitRate_bit_s = imd::firmware::protocol::kNominalBitrate_bit_s;
+/// "1 Mbit/s", "500 kbit/s".
+std::string bit_rate_text() {
+  return kBitRate_bit_s % 1'000'000 == 0 ? fmt::format("{} Mbit/s", kBitRate_bit_s / 1'000'000)
+                                         : fmt::format("{} kbit/s", kBitRate_bit_s / 1000);
+}
 
 struct Options {
   std::string scenario;
@@ -162,7 +170,9 @@ int run(const Options& o, const imd::sim::Scenario& s, imd::hal::QueuedCanBus* c
   firmware::HilTick<T> tick(board, drive, s.faults);
 
   std::cerr << fmt::format("drive_hil: {} on {} as node {}, {} Hz, {} precision{}\n", s.source,
-                           can != nullptr ? can->iface() : "no CAN bus", o.node,
+                           can != nullptr ? fmt::format("{} at {}", can->iface(), bit_rate_text())
+                                          : "no CAN bus",
+                           o.node,
                            std::lround(1.0 / s.sample_period_s), s.precision,
                            gpio != nullptr ? fmt::format(", GPIO {} ({} lines)", gpio->chip_name(),
                                                          gpio->size())
@@ -223,7 +233,10 @@ int main(int argc, char** argv) {
   CLI::App app{"Runs the drive firmware in real time against the simulated motor, over CAN."};
   app.set_version_flag("--version", imd::version::kText);
   app.add_option("scenario", o.scenario, "Scenario file (TOML)")->required();
-  app.add_option("--can", o.can, "SocketCAN interface, e.g. can0 or vcan0; 'none': no bus")
+  app.add_option("--can", o.can,
+                 fmt::format("SocketCAN interface, e.g. can0 (configured for the protocol's {}, "
+                             "else refused) or vcan0; 'none': no bus",
+                             bit_rate_text()))
       ->required();
   app.add_option("--node", o.node, "CAN node id")
       ->check(CLI::Range(0, imd::firmware::protocol::kMaxNodeId));
@@ -295,6 +308,10 @@ int main(int argc, char** argv) {
     const imd::hal::CanIdFilter node_ids{static_cast<uint16_t>(o.node * 32), 0x7E0};
     can = imd::hal::QueuedCanBus::open(o.can, error, {node_ids});
     if (!can) return fail(error);
+    // A CAN controller at another bit rate would disturb the whole bus: refused before the
+    // drive sends anything.
+    const std::string mismatch = imd::hal::bit_rate_mismatch(o.can, kBitRate_bit_s);
+    if (!mismatch.empty()) return fail(mismatch);
   }
   const Lines lines = board_lines(o);
   std::unique_ptr<imd::hal::GpiodLines> gpio;

@@ -30,6 +30,11 @@ struct Signal {
   /// An IEEE 754 single-precision value in 32 bits (a DBC SIG_VALTYPE_ 1 signal); the scale is
   /// 1 and the offset 0.
   bool is_float = false;
+  /// The physical values the drive accepts, when narrower than the raw range (commands): the
+  /// DBC's [min|max]. Without it the DBC shows the raw range. Set with with_range().
+  bool has_range = false;
+  float range_min = 0.0f;
+  float range_max = 0.0f;
 
   constexpr double scale() const noexcept { return double(scale_num) / double(scale_den); }
   constexpr int64_t raw_min() const noexcept {
@@ -39,6 +44,14 @@ struct Signal {
     return is_signed ? (int64_t(1) << (length_bits - 1)) - 1 : (int64_t(1) << length_bits) - 1;
   }
 };
+
+/// `s` with the physical range [min, max] the drive accepts.
+constexpr Signal with_range(Signal s, float min, float max) noexcept {
+  s.has_range = true;
+  s.range_min = min;
+  s.range_max = max;
+  return s;
+}
 
 using Payload = std::array<uint8_t, 8>;
 

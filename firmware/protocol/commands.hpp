@@ -9,6 +9,7 @@
 /// because the host's counter moved on; the first frame after start-up sets it too. The
 /// emergency stop skips the counter check. One counter covers all commands of a node, so a host
 /// that starts late learns where it stands from the heartbeat's command_counter.
+#include <algorithm>
 #include <array>
 #include <cstdint>
 
@@ -65,6 +66,14 @@ struct CommandLimits {
   float max_flux2_Wb2 = 4.0f;      ///< set_flux <= this
 };
 
+/// The limits within the protocol's widest ranges, which the DBC states: no configuration makes
+/// a drive accept a reference beyond kMaxSpeedReference_rad_s or kMaxFlux2Reference_Wb2.
+constexpr CommandLimits within_protocol(CommandLimits l) noexcept {
+  l.max_speed_rad_s = std::min(l.max_speed_rad_s, kMaxSpeedReference_rad_s);
+  l.max_flux2_Wb2 = std::min(l.max_flux2_Wb2, kMaxFlux2Reference_Wb2);
+  return l;
+}
+
 struct Decoded {
   bool for_this_node = false;  ///< false: another node's frame or telemetry, ignored silently
   CommandResult result = CommandResult::unknown_message;
@@ -77,7 +86,7 @@ struct Decoded {
 class CommandDecoder {
  public:
   CommandDecoder(uint8_t node_id, const CommandLimits& limits) noexcept
-      : node_id_(node_id), limits_(limits) {}
+      : node_id_(node_id), limits_(within_protocol(limits)) {}
 
   /// Checks a frame and, if it is a valid command for this node, advances the counter.
   Decoded decode(const hal::CanFrame& frame) noexcept;

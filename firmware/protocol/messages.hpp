@@ -7,15 +7,34 @@
 /// ODrive does. Lower identifiers win arbitration, so the emergency stop is message 1.
 /// Commands (host -> drive) carry a CRC-8 in byte 0 and a 4-bit alive counter in byte 1
 /// (firmware/protocol/e2e.hpp). docs/can/protocol.md explains the behaviour behind each message.
+#include <array>
+#include <cstddef>
 #include <cstdint>
 #include <span>
 
 #include "firmware/protocol/can_signal.hpp"
+#include "firmware/protocol/fault_bits.hpp"
+#include "firmware/protocol/value_tables.hpp"
 
 namespace imd::firmware::protocol {
 
+/// The layout of this table: +1 whenever a message or signal changes on the wire. The drive
+/// sends it in its version frame, and the DBC file's VERSION is it.
+inline constexpr uint8_t kProtocolVersion = 2;
+
+/// The bus's one bit rate: the firmware's CAN controllers, the DBC's Baudrate and the docs all
+/// follow it (tests/dbc/check_bit_rate.py checks the docs).
 inline constexpr uint32_t kNominalBitrate_bit_s = 1'000'000;
 inline constexpr int kMaxNodeId = 63;
+
+inline constexpr int kFastTelemetryMinHz = 10;
+inline constexpr int kFastTelemetryMaxHz = 1000;
+/// The widest set_speed the drive accepts whatever its overspeed threshold (the decoder caps
+/// that threshold here): a 2-pole motor at 300 Hz turns at 1885 rad/s.
+inline constexpr float kMaxSpeedReference_rad_s = 2000.0f;
+/// The largest set_flux the drive accepts whatever its max_flux2_Wb2 (capped here): the
+/// configuration's default, (2 Wb)^2, above the rated flux of the motors this drive is for.
+inline constexpr float kMaxFlux2Reference_Wb2 = 4.0f;
 
 enum class MessageId : uint8_t {
   emergency_stop = 0x01,
@@ -40,6 +59,7 @@ enum class MessageId : uint8_t {
   stage_timing_1 = 0x14,
   stage_timing_2 = 0x15,
   identify_progress = 0x16,
+  version = 0x17,
 };
 
 enum class Direction : uint8_t {
@@ -77,83 +97,28 @@ constexpr uint8_t message_of(uint16_t can_id) noexcept {
   return static_cast<uint8_t>(can_id & 0x1F);
 }
 
-// --- value tables (kept in step with the firmware's enums by static_asserts where they live)
-
-inline constexpr ValueName kStateValues[] = {
-    {0, "calibrating"}, {1, "idle"},     {2, "magnetizing"},
-    {3, "running"},     {4, "stopping"}, {5, "fault"},
-    {6, "unconfigured"}, {7, "identifying"},
-};
-inline constexpr ValueName kFaultValues[] = {
-    {0, "none"},
-    {1, "adc_offset"},
-    {2, "overcurrent"},
-    {3, "magnetizing_timeout"},
-    {4, "non_finite"},
-    {5, "singular_control"},
-    {6, "bus_undervoltage"},
-    {7, "bus_overvoltage"},
-    {8, "overrun"},
-    {9, "overspeed"},
-    {10, "encoder"},
-    {11, "adc_stuck"},
-    {12, "phase_loss"},
-    {13, "command_timeout"},
-    {14, "emergency_stop"},
-    {15, "enable_input"},
-};
-inline constexpr ValueName kControllerValues[] = {{0, "dsmc"}, {1, "iol"}, {2, "ifoc"}};
-inline constexpr ValueName kResetCauseValues[] = {
-    {0, "power_on"}, {1, "watchdog"}, {2, "software"}, {3, "other"}};
-inline constexpr ValueName kStopValues[] = {
-    {0, "none"}, {1, "sto"}, {2, "ss1"}, {3, "dc_brake"}};
-inline constexpr ValueName kLimitedValues[] = {
-    {0, "none"}, {1, "voltage"}, {2, "current"}, {3, "torque"}};
-inline constexpr ValueName kCommandResultValues[] = {
-    {0, "accepted"},      {1, "wrong_length"}, {2, "bad_crc"},     {3, "repeated_counter"},
-    {4, "stale_counter"}, {5, "out_of_range"}, {6, "not_allowed"}, {7, "unknown_message"},
-};
-inline constexpr ValueName kTransitionReasonValues[] = {
-    {0, "calibrated"}, {1, "enable"}, {2, "magnetized"},   {3, "disable"},
-    {4, "stopped"},    {5, "fault"},  {6, "clear_faults"}, {7, "shutdown"},
-    {8, "parameters_written"}, {9, "configured"}, {10, "identify"}, {11, "identified"},
-    {12, "identification_failed"},
-};
-inline constexpr ValueName kMotorFieldValues[] = {
-    {0, "Rs_Ohm"},          {1, "Ls_H"},            {2, "Lm_H"},
-    {3, "Rr_Ohm"},          {4, "Lr_H"},            {5, "J_kgm2"},
-    {6, "pole_pairs"},      {7, "friction_Nms"},    {8, "rated_voltage_V"},
-    {9, "rated_current_A"}, {10, "rated_frequency_Hz"},
-};
-inline constexpr ValueName kParameterOpValues[] = {{0, "read"}, {1, "write"}, {2, "save"}};
-inline constexpr ValueName kIdentifyStepValues[] = {
-    {0, "low_level"}, {1, "high_level"}, {2, "transient_inductance"},
-    {3, "ramp_down"}, {4, "done"},       {5, "failed"},
-    {6, "none"},      {7, "flux_up"},    {8, "accelerate"},
-    {9, "coast"},     {10, "brake"},     {11, "field_down"},
-};
-inline constexpr ValueName kIdentifyFailureValues[] = {
-    {0, "none"},        {1, "not_settled"}, {2, "voltage_limit"}, {3, "implausible"},
-    {4, "no_nameplate"}, {5, "aborted"},    {6, "invalid_record"},
-    {7, "no_motion"},  // done: the rotor did not turn, the mechanics were kept
-    {8, "wrong_direction"}, {9, "overspeed"}, {10, "not_at_rest"}, {11, "stalled"},
-};
-inline constexpr ValueName kParameterStatusValues[] = {
-    {0, "ok"},         {1, "not_idle"},  {2, "unknown_field"}, {3, "not_finite"},
-    {4, "not_positive"}, {5, "negative"}, {6, "not_whole"},     {7, "no_leakage"},
-    {8, "not_set"},    {9, "store_failed"}, {10, "busy"},
-};
-
 // --- the E2E header every command starts with
 inline constexpr Signal kE2eCrc{
     "crc", 0, 8, false, 1, 1, 0.0f, "", "CRC-8 SAE J1850 over the CAN id and bytes 1 to DLC-1"};
 inline constexpr Signal kE2eCounter{
     "counter", 8, 4, false, 1, 1, 0.0f, "", "alive counter, +1 (mod 16) per command frame"};
 
-// --- signals, one array per message. Signal order is the telemetry's field order.
-inline constexpr Signal kHeartbeatSignals[] = {
+/// command_ack.message names the message it answers: its value table is every message's id and
+/// name, filled from kMessages below. Declared here, as command_ack's signals (inside kMessages)
+/// refer to it; kMessageCount gives its size before kMessages exists.
+inline constexpr std::size_t kMessageCount = 23;
+struct MessageIdNames {
+  static const std::array<ValueName, kMessageCount> values;
+};
+
+// The 16-bit fault word (bit n = fault code n) starts at this bit in both messages that carry it.
+inline constexpr uint8_t kHeartbeatFaultWordBit = 8;
+inline constexpr uint8_t kFaultReportFaultWordBit = 8;
+
+// --- signals, one array per message. Signal order is the telemetry's field order; the fault
+// bits (firmware/protocol/fault_bits.hpp) come last and are packed as one word.
+inline constexpr Signal kHeartbeatOwnSignals[] = {
     {"state", 0, 4, false, 1, 1, 0.0f, "", "drive state", kStateValues},
-    {"fault_bits", 8, 16, false, 1, 1, 0.0f, "", "latched faults, bit n = fault code n"},
     {"first_fault", 24, 8, false, 1, 1, 0.0f, "", "first latched fault", kFaultValues},
     {"counter", 32, 8, false, 1, 1, 0.0f, "", "heartbeat count, wraps"},
     {"command_counter", 40, 4, false, 1, 1, 0.0f, "", "alive counter of the last accepted command"},
@@ -172,41 +137,61 @@ inline constexpr Signal kHeartbeatSignals[] = {
     {"reset_cause", 6, 2, false, 1, 1, 0.0f, "", "why the board last started (hal/watchdog.hpp)",
      kResetCauseValues},
 };
-inline constexpr Signal kFaultReportSignals[] = {
+inline constexpr auto kHeartbeatSignals =
+    join(kHeartbeatOwnSignals, fault_bit_signals(kHeartbeatFaultWordBit));
+inline constexpr Signal kFaultReportOwnSignals[] = {
     {"first_fault", 0, 8, false, 1, 1, 0.0f, "", "first latched fault", kFaultValues},
-    {"fault_bits", 8, 16, false, 1, 1, 0.0f, "", "latched faults, bit n = fault code n"},
     {"first_fault_time_ms", 24, 32, false, 1, 1, 0.0f, "ms", "drive time of the first fault"},
     {"detail", 56, 8, false, 1, 1, 0.0f, "",
      "phase (0..2) for overcurrent and phase loss; 3: the power stage's hardware over-current trip"},
 };
+inline constexpr auto kFaultReportSignals =
+    join(kFaultReportOwnSignals, fault_bit_signals(kFaultReportFaultWordBit));
+
+// Commands carry the physical range the drive accepts (the DBC's [min|max]); the rule behind
+// each range is stated with it, and CommandDecoder enforces it.
 inline constexpr Signal kEmptyCommandSignals[] = {kE2eCrc, kE2eCounter};
 inline constexpr Signal kSetSpeedSignals[] = {
     kE2eCrc,
     kE2eCounter,
-    {"speed_ref_rad_s", 16, 32, true, 1, 1000, 0.0f, "rad/s", "mechanical speed reference"}};
+    // +-kMaxSpeedReference_rad_s: the widest overspeed threshold the decoder takes.
+    with_range({"speed_ref_rad_s", 16, 32, true, 1, 1000, 0.0f, "rad/s",
+                "mechanical speed reference, within +-the drive's overspeed threshold"},
+               -kMaxSpeedReference_rad_s, kMaxSpeedReference_rad_s)};
 inline constexpr Signal kSetFluxSignals[] = {
     kE2eCrc,
     kE2eCounter,
-    {"flux2_ref_Wb2", 16, 32, false, 1, 1000000, 0.0f, "Wb^2",
-     "squared flux reference: rotor flux (dsmc) or stator flux (iol)"}};
-inline constexpr ValueName kIdentifyRotateValues[] = {{0, "standstill"}, {1, "rotate"}};
+    // 0..kMaxFlux2Reference_Wb2: the largest max_flux2_Wb2 the decoder takes; the drive's own
+    // floor (min_flux2_command_Wb2, above 0) is configured per drive.
+    with_range({"flux2_ref_Wb2", 16, 32, false, 1, 1000000, 0.0f, "Wb^2",
+                "squared flux reference: rotor flux (dsmc) or stator flux (iol)"},
+               0.0f, kMaxFlux2Reference_Wb2)};
 inline constexpr Signal kIdentifySignals[] = {
     kE2eCrc,
     kE2eCounter,
-    {"rotate", 16, 8, false, 1, 1, 0.0f, "",
-     "1: after the standstill steps, turn the motor to measure inertia and friction (the shaft "
-     "must be free to turn); 0: standstill only, the mechanics are kept; others are rejected",
-     kIdentifyRotateValues}};
+    // 0..1: the values kIdentifyRotateValues names, the only ones accepted.
+    with_range({"rotate", 16, 8, false, 1, 1, 0.0f, "",
+                "1: after the standstill steps, turn the motor to measure inertia and friction "
+                "(the shaft must be free to turn); 0: standstill only, the mechanics are kept; "
+                "others are rejected",
+                kIdentifyRotateValues},
+               0.0f, float(std::size(kIdentifyRotateValues) - 1))};
 inline constexpr Signal kSelectControllerSignals[] = {
     kE2eCrc,
     kE2eCounter,
-    {"controller", 16, 8, false, 1, 1, 0.0f, "", "controller, only while idle", kControllerValues}};
+    // 0..2: the laws kControllerValues names, the only ones accepted.
+    with_range({"controller", 16, 8, false, 1, 1, 0.0f, "", "controller, only while idle",
+                kControllerValues},
+               0.0f, float(std::size(kControllerValues) - 1))};
 inline constexpr Signal kSetTelemetryRateSignals[] = {
     kE2eCrc,
     kE2eCounter,
-    {"rate_Hz", 16, 16, false, 1, 1, 0.0f, "Hz", "fast telemetry rate, 10..1000"}};
+    // kFastTelemetryMinHz..kFastTelemetryMaxHz, what Telemetry::set_rate_Hz takes.
+    with_range({"rate_Hz", 16, 16, false, 1, 1, 0.0f, "Hz", "fast telemetry rate, 10..1000"},
+               float(kFastTelemetryMinHz), float(kFastTelemetryMaxHz))};
 inline constexpr Signal kCommandAckSignals[] = {
-    {"message", 0, 8, false, 1, 1, 0.0f, "", "message id of the command"},
+    {"message", 0, 8, false, 1, 1, 0.0f, "", "message id of the command",
+     {MessageIdNames::values.data(), kMessageCount}},
     {"counter", 8, 4, false, 1, 1, 0.0f, "", "its alive counter"},
     {"result", 12, 4, false, 1, 1, 0.0f, "", "accepted or why it was rejected",
      kCommandResultValues},
@@ -222,9 +207,14 @@ inline constexpr Signal kStateChangeSignals[] = {
 inline constexpr Signal kParameterAccessSignals[] = {
     kE2eCrc,
     kE2eCounter,
-    {"op", 12, 4, false, 1, 1, 0.0f, "", "read, write (only while idle) or save the record",
-     kParameterOpValues},
-    {"field", 16, 8, false, 1, 1, 0.0f, "", "the record's field (read, write)", kMotorFieldValues},
+    // 0..2: the operations kParameterOpValues names; another is rejected as out of range.
+    with_range({"op", 12, 4, false, 1, 1, 0.0f, "",
+                "read, write (only while idle) or save the record", kParameterOpValues},
+               0.0f, float(std::size(kParameterOpValues) - 1)),
+    // 0..10: the fields kMotorFieldValues names; another is answered with unknown_field.
+    with_range({"field", 16, 8, false, 1, 1, 0.0f, "", "the record's field (read, write)",
+                kMotorFieldValues},
+               0.0f, float(std::size(kMotorFieldValues) - 1)),
     {"value", 24, 32, false, 1, 1, 0.0f, "", "the new value in the field's unit (write)", {},
      true},
 };
@@ -286,6 +276,19 @@ inline constexpr Signal kStageTiming2Signals[] = {
     {"publish_us", 48, 16, false, 1, 100, 0.0f, "us", "publish stage of the tick before"},
 };
 
+// The patch number has 7 bits so that the dirty flag fits in the frame beside the 32-bit hash.
+inline constexpr Signal kVersionSignals[] = {
+    {"protocol_version", 0, 8, false, 1, 1, 0.0f, "",
+     "kProtocolVersion: the layout of the message table the firmware was built with"},
+    {"firmware_major", 8, 8, false, 1, 1, 0.0f, "", "firmware version, major"},
+    {"firmware_minor", 16, 8, false, 1, 1, 0.0f, "", "firmware version, minor"},
+    {"firmware_patch", 24, 7, false, 1, 1, 0.0f, "", "firmware version, patch"},
+    {"dirty", 31, 1, false, 1, 1, 0.0f, "",
+     "1: built from a tree with uncommitted changes to tracked files"},
+    {"git_hash", 32, 32, false, 1, 1, 0.0f, "",
+     "the first 32 bits of the git commit the firmware was built from (0: none)"},
+};
+
 inline constexpr Message kMessages[] = {
     {MessageId::emergency_stop, "emergency_stop", 2, Direction::host_to_drive, Timing::on_event, 0,
      "PWM off at once, latched as a fault", kEmptyCommandSignals},
@@ -335,7 +338,23 @@ inline constexpr Message kMessages[] = {
      100, "execution time of the tick's first four stages at 10 Hz", kStageTiming1Signals},
     {MessageId::stage_timing_2, "stage_timing_2", 8, Direction::drive_to_host, Timing::cyclic,
      100, "execution time of the tick's last four stages at 10 Hz", kStageTiming2Signals},
+    {MessageId::version, "version", 8, Direction::drive_to_host, Timing::on_event, 0,
+     "protocol and firmware version, sent once at start-up before any other frame",
+     kVersionSignals},
 };
+static_assert(std::size(kMessages) == kMessageCount, "kMessageCount counts kMessages");
+
+/// Every message's id and name, by id.
+inline constexpr std::array<ValueName, kMessageCount> MessageIdNames::values = [] {
+  std::array<ValueName, kMessageCount> names{};
+  for (std::size_t i = 0; i < kMessageCount; ++i) {
+    ValueName next{static_cast<int32_t>(kMessages[i].id), kMessages[i].name};
+    std::size_t j = i;
+    for (; j > 0 && names[j - 1].raw > next.raw; --j) names[j] = names[j - 1];
+    names[j] = next;
+  }
+  return names;
+}();
 
 /// The definition of a message id, or nullptr.
 constexpr const Message* find_message(uint8_t message_id) noexcept {
@@ -358,8 +377,5 @@ constexpr int find_signal(const Message& m, const char* name) noexcept {
   }
   return -1;
 }
-
-inline constexpr int kFastTelemetryMinHz = 10;
-inline constexpr int kFastTelemetryMaxHz = 1000;
 
 }  // namespace imd::firmware::protocol

@@ -59,6 +59,7 @@ Summary run(const Scenario& s, const RunCallbacks& callbacks) {
     for (; next_command < commands.size() && commands[next_command].tick <= k; ++next_command) {
       board.can_side().inject(
           commands[next_command].frame);  // a full queue loses it, as a bus would
+      if (callbacks.host_frame) callbacks.host_frame(t_s, commands[next_command].frame);
     }
     faults.inject_due(board, t_s, [&](const FaultInjection& fault, bool accepted) {
       // load_scenario refuses such faults; a scenario built in code may still hold one.

@@ -81,16 +81,21 @@ struct RunCallbacks {
   /// A host acting on the board between ticks (frames, faults, load), seeing the drive's status.
   using Host = std::function<void(uint64_t k, double t_s, SimBoard& board,
                                   const firmware::DriveStatus& status)>;
-  RunCallbacks(Row row_ = {}, Progress progress_ = {}, Frame can_frame_ = {}, Host host_ = {})
+  RunCallbacks(Row row_ = {}, Progress progress_ = {}, Frame can_frame_ = {}, Host host_ = {},
+               Frame host_frame_ = {})
       : row(std::move(row_)),
         progress(std::move(progress_)),
         can_frame(std::move(can_frame_)),
-        host(std::move(host_)) {}
+        host(std::move(host_)),
+        host_frame(std::move(host_frame_)) {}
 
   Row row;            ///< every tick, if set
   Progress progress;  ///< about once per wall-clock second: simulated time so far
   Frame can_frame;    ///< every frame the firmware sent, with the time of the tick that sent it
   Host host;          ///< before every tick, after the scenario's own frames and faults
+  /// every frame of the scenario's [[can_commands]], with the time of the tick it is delivered
+  /// before (also when the drive's full receive queue then loses it, as a bus would)
+  Frame host_frame;
 };
 
 /// Throws std::invalid_argument on a fault SimBoard refuses (fault_parameter_error), which

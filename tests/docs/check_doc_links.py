@@ -14,6 +14,7 @@ from pathlib import Path
 USER_PAGES = [
     "docs/getting-started.md",
     "docs/flashing.md",
+    "docs/install.md",
     "docs/configuration.md",
     "docs/tuning.md",
     "docs/troubleshooting.md",

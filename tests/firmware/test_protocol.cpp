@@ -184,6 +184,29 @@ TEST_F(Decoder, RejectsOutOfRangeValues) {
             CommandResult::accepted);
 }
 
+// The DBC states the protocol's widest ranges; a configuration beyond them is capped, so that
+// no drive accepts a reference the DBC calls out of range.
+TEST(DecoderLimits, AreCappedAtTheProtocolsRanges) {
+  CommandDecoder decoder{1, CommandLimits{5000.0f, 0.01f, 10.0f}};
+  CommandEncoder encoder{1};
+  const float speed = protocol::kMaxSpeedReference_rad_s;
+  const float flux2 = protocol::kMaxFlux2Reference_Wb2;
+  EXPECT_EQ(decoder.decode(encoder.encode({CommandKind::set_speed, -speed})).result,
+            CommandResult::accepted);
+  EXPECT_EQ(decoder.decode(encoder.encode({CommandKind::set_speed, speed + 1.0f})).result,
+            CommandResult::out_of_range);
+  EXPECT_EQ(decoder.decode(encoder.encode({CommandKind::set_flux, flux2})).result,
+            CommandResult::accepted);
+  EXPECT_EQ(decoder.decode(encoder.encode({CommandKind::set_flux, flux2 + 0.5f})).result,
+            CommandResult::out_of_range);
+  // The table's ranges are these constants: what the DBC's [min|max] shows.
+  const protocol::Signal& speed_signal = protocol::kSetSpeedSignals[2];
+  EXPECT_TRUE(speed_signal.has_range);
+  EXPECT_EQ(speed_signal.range_min, -speed);
+  EXPECT_EQ(speed_signal.range_max, speed);
+  EXPECT_EQ(protocol::kSetFluxSignals[2].range_max, flux2);
+}
+
 TEST_F(Decoder, EmergencyStopIgnoresTheCounter) {
   EXPECT_EQ(decoder.decode(encoder.encode({CommandKind::enable})).result, CommandResult::accepted);
   encoder.set_next_counter(9);  // out of step: every other command is refused...

@@ -57,7 +57,7 @@ TEST(Scenario, BadPlantKeysAreRejectedWithTheirName) {
   EXPECT_NE(error_of(kPaper, {"plant.Rr_Ohm=-1"}).find("plant.Rr_Ohm = -1"), std::string::npos);
   EXPECT_NE(error_of(kPaper, {"plant.Lm_H=0.5"}).find("plant.Lm_H = 0.5: must satisfy"),
             std::string::npos);
-  EXPECT_NE(error_of(kPaper, {"plant.pole_pairs=1.5"}).find("plant.pole_pairs must be an integer"),
+  EXPECT_NE(error_of(kPaper, {"plant.pole_pairs=1.5"}).find("plant.pole_pairs = 1.5: must be an integer"),
             std::string::npos);
 }
 

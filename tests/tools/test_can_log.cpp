@@ -1,10 +1,13 @@
-// The candump -L log format: the writer's exact text, writer/parser round trips, one specific
-// error per kind of malformed line, and the file reader's PATH:LINE messages.
+// The candump -L log format: the writer's exact text, writer/parser round trips, every frame
+// kind candump writes (tests/tools/test_can_log_kinds.cpp), one specific error per kind of
+// malformed line, and the file reader's PATH:LINE messages.
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <iterator>
+#include <optional>
 #include <ostream>
 #include <string>
 
@@ -50,10 +53,12 @@ TEST(can_log_parser, RoundTripsEveryLengthAndTime) {
       EXPECT_EQ(r.line->time_us, std::llround(t * 1e6)) << text;
       EXPECT_NEAR(r.line->time_s, t, 1e-6) << text;
       EXPECT_EQ(r.line->iface, "can0");
-      EXPECT_FALSE(r.line->remote);
-      EXPECT_EQ(r.line->frame.id, f.id);
-      EXPECT_EQ(r.line->frame.length, f.length);
-      EXPECT_EQ(r.line->frame.data, f.data) << text;
+      EXPECT_EQ(r.line->direction, Direction::unmarked);
+      const std::optional<hal::CanFrame> back = classic_frame(r.line->frame);
+      ASSERT_TRUE(back.has_value()) << text;
+      EXPECT_EQ(back->id, f.id);
+      EXPECT_EQ(back->length, f.length);
+      EXPECT_EQ(back->data, f.data) << text;
       EXPECT_EQ(format_log_line(r.line->time_s, r.line->iface, r.line->frame), text);
     }
   }
@@ -66,8 +71,9 @@ TEST(can_log_parser, AcceptsLowerCaseHexAndRemoteFrames) {
   EXPECT_EQ(lower.line->frame.data[2], 0xEF);
   const ParseResult remote = parse_log_line("(1.000000) can0 022#R");
   ASSERT_TRUE(remote.ok()) << remote.error.message;
-  EXPECT_TRUE(remote.line->remote);
+  EXPECT_EQ(remote.line->frame.type, FrameType::remote);
   EXPECT_EQ(remote.line->frame.length, 0);
+  EXPECT_FALSE(classic_frame(remote.line->frame).has_value());
   const ParseResult remote3 = parse_log_line("(1.000000) can0 022#R3");
   ASSERT_TRUE(remote3.ok()) << remote3.error.message;
   EXPECT_EQ(remote3.line->frame.length, 3);
@@ -86,9 +92,11 @@ void PrintTo(const Malformed& m, std::ostream* os) {
 /// The test name of a case: its kind and its index.
 std::string case_name(const ::testing::TestParamInfo<Malformed>& info) {
   static constexpr const char* kKinds[] = {
-      "empty_line",   "bad_timestamp",  "bad_separator",    "missing_field", "bad_interface",
-      "missing_hash", "bad_identifier", "identifier_range", "extended_id",   "can_fd_frame",
-      "bad_data",     "odd_data",       "data_too_long",    "bad_remote",    "trailing_text"};
+      "empty_line",   "bad_timestamp",  "bad_separator",    "missing_field",   "bad_interface",
+      "missing_hash", "bad_identifier", "identifier_range", "bad_error_frame", "bad_fd_flags",
+      "fd_length",    "bad_data",       "odd_data",         "data_too_long",   "bad_remote",
+      "bad_raw_dlc",  "trailing_text"};
+  static_assert(std::size(kKinds) == std::size_t(ParseErrorKind::trailing_text) + 1);
   return std::string(kKinds[int(info.param.kind)]) + "_" + std::to_string(info.index);
 }
 
@@ -116,7 +124,8 @@ INSTANTIATE_TEST_SUITE_P(
         Malformed{"(.000100) can0 022#01", K::bad_timestamp, "'(.000100)'"},
         Malformed{"(1234567890123.000000) can0 022#01", K::bad_timestamp, "6 decimals"},
         Malformed{"(0.000100)can0 022#01", K::bad_separator, "one space after the timestamp"},
-        Malformed{"(0.000100)  can0 022#01", K::bad_separator, "one space after the timestamp"},
+        Malformed{"(0.000100)            vcan0 022#01", K::bad_separator,
+                  "12 spaces before interface 'vcan0': candump pads names to at most 15"},
         Malformed{"(0.000100)\tcan0 022#01", K::bad_separator, "'\\x09c'"},
         Malformed{"(0.000100) can0  022#01", K::bad_separator, "after interface 'can0'"},
         Malformed{"(0.000100)", K::missing_field, "missing interface and frame"},
@@ -132,17 +141,51 @@ INSTANTIATE_TEST_SUITE_P(
         Malformed{"(0.000100) can0 00022#01", K::bad_identifier, "bad identifier '00022'"},
         Malformed{"(0.000100) can0 800#01", K::identifier_range, "above 7FF"},
         Malformed{"(0.000100) can0 FFFFFFFF#01", K::identifier_range, "above 1FFFFFFF"},
-        Malformed{"(0.000100) can0 18FF0001#0102", K::extended_identifier,
-                  "extended identifier '18FF0001' (29 bits): not supported by the protocol"},
-        Malformed{"(0.000100) can0 022##10102", K::can_fd_frame, "CAN FD frame"},
+        Malformed{"(0.000100) can0 40000000#01", K::identifier_range, "above 3FFFFFFF"},
+        Malformed{"(0.000100) can0 18FF000G#01", K::bad_identifier, "bad identifier '18FF000G'"},
+        Malformed{"(0.000100) can0 018FF0001#01", K::bad_identifier, "or 8 for an extended"},
+        Malformed{"(0.000100) can0 18FF0001#001122334455667788", K::data_too_long,
+                  "9 bytes: classic CAN carries at most 8"},
+        Malformed{"(0.000100) can0 18FF0001#012", K::odd_data, "odd number of hex digits (3)"},
+        Malformed{"(0.000100) can0 20000004##10004", K::bad_error_frame,
+                  "error frame '20000004##10004' written as CAN FD"},
+        Malformed{"(0.000100) can0 20000004#R", K::bad_error_frame, "written as remote ('R')"},
+        Malformed{"(0.000100) can0 20000004#000400000000000000", K::data_too_long, "9 bytes"},
+        Malformed{"(0.000100) can0 20000004#00X4", K::bad_data, "'X' is not a hex digit"},
+        Malformed{"(0.000100) can0 022##", K::bad_fd_flags, "one hex digit of flags after '##'"},
+        Malformed{"(0.000100) can0 022##G01", K::bad_fd_flags, "'##G01'"},
+        Malformed{"(0.000100) can0 022###101", K::bad_fd_flags, "'###101'"},
+        Malformed{"(0.000100) can0 022##1001122334455667788", K::fd_length,
+                  "has 9 bytes: a CAN FD frame carries 0..8, 12, 16, 20, 24, 32, 48 or 64"},
+        Malformed{"(0.000100) can0 18DA00F1##5000102030405060708090A0B0C0D0E0F1011121314",
+                  K::fd_length, "has 21 bytes"},
+        Malformed{"(0.000100) can0 18DA00F1##5000102030405060708090A0B0C0D0E0F101112"
+                  "131415161718191A1B1C1D1E1F202122232425262728292A2B2C2D2E2F30313233343536"
+                  "3738393A3B3C3D3E3F40",
+                  K::data_too_long, "65 bytes: CAN FD carries at most 64"},
+        Malformed{"(0.000100) can0 022##1012", K::odd_data, "odd number of hex digits (3)"},
+        Malformed{"(0.000100) can0 022##10X", K::bad_data, "'X' is not a hex digit"},
+        Malformed{"(0.000100) can0 022##1AA_E", K::bad_data, "'_' is not a hex digit"},
         Malformed{"(0.000100) can0 022#01X2", K::bad_data, "'X' is not a hex digit"},
         Malformed{"(0.000100) can0 022#01.02", K::bad_data, "'.' is not a hex digit"},
-        Malformed{"(0.000100) can0 022#1122334455667788_E", K::bad_data, "'_'"},
+        Malformed{"(0.000100) can0 022#1122_E", K::bad_raw_dlc,
+                  "bad raw DLC '_E': expected '_' and one digit 9..F, after exactly 8 data bytes"},
+        Malformed{"(0.000100) can0 022#1122334455667788_8", K::bad_raw_dlc, "'_8'"},
+        Malformed{"(0.000100) can0 022#1122334455667788_", K::bad_raw_dlc, "'_'"},
+        Malformed{"(0.000100) can0 022#1122334455667788_EE", K::bad_raw_dlc, "'_EE'"},
+        Malformed{"(0.000100) can0 022#R3_E", K::bad_raw_dlc, "after exactly 8 data bytes"},
+        Malformed{"(0.000100) can0 022#R8_G", K::bad_raw_dlc, "'_G'"},
         Malformed{"(0.000100) can0 022#012", K::odd_data, "odd number of hex digits (3)"},
         Malformed{"(0.000100) can0 022#001122334455667788", K::data_too_long, "9 bytes"},
         Malformed{"(0.000100) can0 022#R9", K::bad_remote, "bad remote frame 'R9'"},
         Malformed{"(0.000100) can0 022#R12", K::bad_remote, "one length digit 0..8"},
-        Malformed{"(0.000100) can0 022#01 T", K::trailing_text, "after the frame: ' T'"},
+        Malformed{"(0.000100) can0 022#RR", K::bad_remote, "bad remote frame 'RR'"},
+        Malformed{"(0.000100) can0 022#01 X", K::trailing_text,
+                  "after the frame: ' X' (only ' T' or ' R' may follow"},
+        Malformed{"(0.000100) can0 022#01 t", K::trailing_text, "' t'"},
+        Malformed{"(0.000100) can0 022#01  T", K::trailing_text, "'  T'"},
+        Malformed{"(0.000100) can0 022#01 T ", K::trailing_text, "' T '"},
+        Malformed{"(0.000100) can0 022#01 TR", K::trailing_text, "' TR'"},
         Malformed{"(0.000100) can0 022#01 ", K::trailing_text, "after the frame: ' '"}),
     case_name);
 

@@ -26,10 +26,13 @@ using protocol::MessageId;
 
 constexpr uint8_t kNode = 1;
 
-hal::CanFrame heartbeat(float state, float first_fault = 0.0f, float command_counter = 0.0f) {
-  return encode_frame(kNode, MessageId::heartbeat,
-                      {state, 0.0f, first_fault, 7.0f, command_counter, 1.0f, 0.0f, 2.0f, 1.0f,
-                       3.0f});
+hal::CanFrame heartbeat(float state, float first_fault = 0.0f, float command_counter = 0.0f,
+                        uint16_t fault_bits = 0) {
+  hal::CanFrame frame =
+      encode_frame(kNode, MessageId::heartbeat,
+                   {state, first_fault, 7.0f, command_counter, 1.0f, 0.0f, 2.0f, 1.0f, 3.0f});
+  protocol::set_fault_bits(frame.data, protocol::kHeartbeatFaultWordBit, fault_bits);
+  return frame;
 }
 hal::CanFrame speed_flux(float speed_rad_s) {
   return encode_frame(kNode, MessageId::telemetry_speed_flux, {speed_rad_s, 100.0f, 0.81f, 0.8f});
@@ -44,14 +47,47 @@ hal::CanFrame voltage(float sample) {
 TEST(drive_monitor_decode, NamesEnumeratedValues) {
   const DecodedFrame d = decode_frame(heartbeat(3.0f, 2.0f), kNode);
   ASSERT_EQ(d.kind, FrameKind::decoded);
-  ASSERT_EQ(d.signal_count, 13u);
+  ASSERT_EQ(d.signal_count, 27u);  // 12 of its own, one per fault code 1..15
   EXPECT_STREQ(d.signals[0].signal->name, "state");
   EXPECT_STREQ(d.signals[0].value_name, "running");
-  EXPECT_STREQ(d.signals[2].value_name, "overcurrent");
+  EXPECT_STREQ(d.signals[1].value_name, "overcurrent");
+  EXPECT_STREQ(d.signals[12].signal->name, "fault_adc_offset");
+  EXPECT_STREQ(d.signals[26].signal->name, "fault_enable_input");
   EXPECT_EQ(describe(d),
-            "heartbeat state=running fault_bits=0 first_fault=overcurrent counter=7 "
+            "heartbeat state=running first_fault=overcurrent counter=7 "
             "command_counter=0 controller=iol can_bus_off=0 rejected_commands=2 limited=voltage "
-            "transitions=3 stop=none brake=0 reset_cause=power_on");
+            "transitions=3 stop=none brake=0 reset_cause=power_on faults=none");
+}
+
+TEST(drive_monitor_decode, ReadsTheFaultBitsAsOneWord) {
+  // Bits 2 and 10 of the word (overcurrent, encoder) are bits 10 and 18 of the frame.
+  const hal::CanFrame frame = heartbeat(5.0f, 2.0f, 0.0f, (1u << 2) | (1u << 10));
+  EXPECT_EQ(frame.data[1], 0x04);
+  EXPECT_EQ(frame.data[2], 0x04);
+  const DecodedFrame d = decode_frame(frame, kNode);
+  EXPECT_EQ(d.signals[13].raw, 1);  // fault_overcurrent
+  EXPECT_EQ(d.signals[21].raw, 1);  // fault_encoder
+  EXPECT_NE(describe(d).find(" faults=overcurrent,encoder"), std::string::npos) << describe(d);
+  DriveMonitor monitor(kNode);
+  monitor.feed(0.0, frame);
+  EXPECT_EQ(monitor.status().heartbeat.fault_bits, (1 << 2) | (1 << 10));
+}
+
+TEST(drive_monitor_decode, ShowsTheVersionFrame) {
+  hal::CanFrame frame =
+      encode_frame(kNode, MessageId::version, {float(protocol::kProtocolVersion), 1, 2, 3, 1});
+  const protocol::Message& m = protocol::message(MessageId::version);
+  protocol::set_raw(frame.data, m.signals[std::size_t(protocol::find_signal(m, "git_hash"))],
+                    0xA2E14617);
+  DriveMonitor monitor(kNode);
+  monitor.feed(0.0, frame);
+  const VersionStatus& v = monitor.status().version;
+  EXPECT_EQ(v.count, 1u);
+  EXPECT_EQ(v.git_hash, 0xA2E14617u);
+  const std::string table = render_table(monitor.status(), kNode, "can0");
+  const std::string line = "firmware       1.2.3+ga2e14617.dirty (protocol " +
+                           std::to_string(protocol::kProtocolVersion) + ")";
+  EXPECT_NE(table.find(line), std::string::npos) << table;
 }
 
 TEST(drive_monitor_decode, SortsOutOtherNodesUnknownIdsAndWrongLengths) {
@@ -73,7 +109,7 @@ TEST(drive_monitor_decode, PrintsValuesAtTheSignalsResolution) {
   EXPECT_EQ(format_physical(speed, -0.01), "-0.01");
   EXPECT_EQ(format_physical(protocol::kSpeedFluxSignals[2], 8099 * 1e-4), "0.8099");  // 1e-4
   EXPECT_EQ(format_physical(protocol::kCurrentSignals[3], 3017 * 0.1), "301.7");      // 0.1 V
-  EXPECT_EQ(format_physical(protocol::kHeartbeatSignals[3], 7.0), "7");
+  EXPECT_EQ(format_physical(protocol::kHeartbeatSignals[2], 7.0), "7");  // counter
 }
 
 TEST(drive_monitor_rows, EmitsARowWhenTheVoltageFrameArrives) {

@@ -48,10 +48,11 @@ function readText(path) {
   }
 }
 
-// A candump -L line: "(1700000000.000100) can0 022#0103000000000000". Standard ids have 3 hex
+// A candump -L line: "(1700000000.000100) can0 022#0103000000000000", with " T" or " R" after
+// it from candump -x (transmitted or received by the capturing host). Standard ids have 3 hex
 // digits, extended ids 8; remote frames ("R") and CAN FD frames ("##") are not decoded.
 const kFrameLine =
-    /^\((\d+(?:\.\d+)?)\)\s+(\S+)\s+([0-9A-Fa-f]{3}|[0-9A-Fa-f]{8})#([0-9A-Fa-f]*|R\d?)$/;
+    /^\((\d+(?:\.\d+)?)\)\s+(\S+)\s+([0-9A-Fa-f]{3}|[0-9A-Fa-f]{8})#([0-9A-Fa-f]*|R\d?)(?: [TR])?$/;
 const kExtendedFlag = 0x80000000;  // how DBC files mark a 29-bit id
 
 function parseFrame(line) {

@@ -1,12 +1,15 @@
 // dbc_gen: writes the DBC file and the Markdown reference of the drive's CAN protocol for one
-// node, from the message table in firmware/protocol/messages.hpp.
+// node (or one DBC file for several drives on one bus, --nodes), from the message table in
+// firmware/protocol/messages.hpp.
 #include <imd_version.hpp>
 #include <CLI/CLI.hpp>
 #include <cerrno>
 #include <cstring>
 #include <fstream>
 #include <iostream>
+#include <set>
 #include <string>
+#include <vector>
 
 #include "firmware/protocol/messages.hpp"
 #include "writers.hpp"
@@ -54,9 +57,21 @@ int main(int argc, char** argv) {
   app.add_option("--node", node_id, "CAN node id of the drive")
       ->check(kNodeId)
       ->capture_default_str();
+  std::vector<std::string> node_list;
+  app.add_option("--nodes", node_list,
+                 "One DBC file for several drives on one bus, e.g. 1,2,5: nodes Drive1, Drive2, "
+                 "Drive5, message names suffixed _1, _2, _5")
+      ->delimiter(',')
+      ->check(kNodeId)
+      ->excludes("--node")
+      ->type_name("ID,ID,...");
   app.add_option("--output", dbc_path, "Write the DBC file here (default: standard output)")
       ->type_name("PATH");
   app.add_option("--markdown", markdown_path, "Also write the Markdown protocol reference here")
+      ->type_name("PATH");
+  std::string python_path;
+  app.add_option("--python", python_path,
+                 "Also write the table as a Python module (tools/python/imdrive/protocol_table.py)")
       ->type_name("PATH");
   try {
     app.parse(argc, argv);
@@ -66,7 +81,18 @@ int main(int argc, char** argv) {
   }
 
   const auto node = static_cast<uint8_t>(node_id);
-  const std::string dbc = imd::tools::dbc::dbc_text(node);
+  std::vector<uint8_t> nodes;
+  for (const std::string& id : node_list) nodes.push_back(static_cast<uint8_t>(std::stoi(id)));
+  if (!nodes.empty() && std::set<uint8_t>(nodes.begin(), nodes.end()).size() != nodes.size()) {
+    std::cerr << "dbc_gen: --nodes: each node id once (two drives cannot share one)\n";
+    return kExitBadInput;
+  }
+  if (!nodes.empty() && !markdown_path.empty()) {
+    std::cerr << "dbc_gen: --markdown describes one node: give --node, not --nodes\n";
+    return kExitBadInput;
+  }
+  const std::string dbc =
+      nodes.empty() ? imd::tools::dbc::dbc_text(node) : imd::tools::dbc::dbc_text(nodes);
   std::string error;
   if (dbc_path.empty()) {
     std::cout << dbc;
@@ -75,6 +101,9 @@ int main(int argc, char** argv) {
   }
   if (error.empty() && !markdown_path.empty()) {
     error = write_file("--markdown", markdown_path, imd::tools::dbc::markdown_text(node));
+  }
+  if (error.empty() && !python_path.empty()) {
+    error = write_file("--python", python_path, imd::tools::dbc::python_text());
   }
   if (!error.empty()) {
     std::cerr << "dbc_gen: " << error << '\n';

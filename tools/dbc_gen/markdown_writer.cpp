@@ -64,6 +64,11 @@ void write_introduction(Out out, uint8_t node_id) {
                  "Commands (host to drive) start\nwith an E2E header: a CRC-8 (SAE J1850) in byte "
                  "0 and a 4-bit alive counter in bits 8..11.\n\n",
                  plain_decimal(protocol::kNominalBitrate_bit_s / 1e6), node_id, node_id * 32);
+  fmt::format_to(out,
+                 "Protocol version {}: the drive sends it in its `version` frame once at start-up, "
+                 "and the DBC\nfile's `VERSION` is it. A command's range is the one the drive "
+                 "accepts; other ranges are\nwhat the signal's bits can carry.\n\n",
+                 protocol::kProtocolVersion);
 }
 
 void write_summary(Out out, uint8_t node_id) {

@@ -14,9 +14,9 @@ std::string plain_decimal(double value) {
   return std::string(buffer, result.ptr);
 }
 
-double decimal_offset(const Signal& s) {
+double decimal(float value) {
   char buffer[64];  // the shortest text that reads back as the float
-  const auto result = std::to_chars(buffer, buffer + sizeof buffer - 1, s.offset);
+  const auto result = std::to_chars(buffer, buffer + sizeof buffer - 1, value);
   *result.ptr = '\0';
   return std::strtod(buffer, nullptr);
 }

@@ -21,16 +21,22 @@ double physical(const Signal& s, int64_t raw);
 inline std::string scale_text(const Signal& s) {
   return plain_decimal(s.scale());
 }
-/// The offset as the decimal the table wrote (0.1f is 0.1, not 0.10000000149).
-double decimal_offset(const Signal& s);
+/// A float of the table as the decimal the table wrote (0.1f is 0.1, not 0.10000000149).
+double decimal(float value);
+inline double decimal_offset(const Signal& s) {
+  return decimal(s.offset);
+}
 inline std::string offset_text(const Signal& s) {
   return plain_decimal(decimal_offset(s));
 }
-// A float signal's range is the float's: a DBC writes it as [0|0] (no range).
+// The range the drive accepts where the table gives one, else the raw range. A float signal's
+// range is the float's: a DBC writes it as [0|0] (no range).
 inline std::string min_text(const Signal& s) {
+  if (s.has_range) return plain_decimal(decimal(s.range_min));
   return s.is_float ? "0" : plain_decimal(physical(s, s.raw_min()));
 }
 inline std::string max_text(const Signal& s) {
+  if (s.has_range) return plain_decimal(decimal(s.range_max));
   return s.is_float ? "0" : plain_decimal(physical(s, s.raw_max()));
 }
 
@@ -88,8 +94,39 @@ constexpr bool signal_is_writable(const Signal& s, int length_bytes) {
   for (const auto& v : s.values) {
     if (!is_dbc_string(v.name) || v.raw < s.raw_min() || v.raw > s.raw_max()) return false;
   }
+  // A range lies within what the raw bits can say (scale > 0: raw_min maps to the lowest).
+  const double lowest = double(s.raw_min()) * s.scale() + double(s.offset);
+  const double highest = double(s.raw_max()) * s.scale() + double(s.offset);
+  if (s.has_range && (s.is_float || !(s.range_min <= s.range_max) || s.range_min < lowest ||
+                      s.range_max > highest)) {
+    return false;
+  }
   return true;
 }
+
+/// Unitless whole numbers that count, check or identify rather than name a choice: they need no
+/// value table. (detail's meaning depends on the fault: docs/can/protocol.md lists it.)
+inline constexpr std::string_view kPlainNumberSignals[] = {
+    "crc",            "counter",        "command_counter", "rejected_commands",
+    "transitions",    "rejected_total", "sample",          "overruns",
+    "detail",         "protocol_version", "firmware_major", "firmware_minor",
+    "firmware_patch", "git_hash",
+};
+
+/// An enumerated signal (unitless, whole-numbered, wider than a flag, and not a plain number)
+/// has a value table, so that tools show names, not numbers.
+constexpr bool enumeration_is_named(const Signal& s) {
+  const bool whole = !s.is_float && s.scale_num == 1 && s.scale_den == 1 && s.offset == 0.0f;
+  if (!whole || *s.unit != '\0' || s.length_bits == 1 || !s.values.empty()) return true;
+  for (const std::string_view name : kPlainNumberSignals) {
+    if (name == s.name) return true;
+  }
+  return false;
+}
+static_assert(!enumeration_is_named(Signal{"mode", 0, 4, false}) &&
+                  enumeration_is_named(Signal{"counter", 0, 4, false}) &&
+                  enumeration_is_named(Signal{"flag", 0, 1, false}),
+              "an unnamed 4-bit mode is an enumeration without a table; counters and flags not");
 
 constexpr uint64_t bit_mask(const Signal& s) {
   return (s.length_bits >= 64 ? ~uint64_t(0) : (uint64_t(1) << s.length_bits) - 1) << s.start_bit;
@@ -97,12 +134,17 @@ constexpr uint64_t bit_mask(const Signal& s) {
 
 /// Valid names and texts, signals inside their frame, no two sharing a bit or a name.
 constexpr bool message_is_writable(const Message& m) {
-  if (!is_identifier(m.name) || !is_dbc_string(m.comment) || m.length > 8) return false;
+  // "_63": the suffix a multi-drive file adds must keep the name within the 32-character limit.
+  if (!is_identifier(m.name) || std::string_view(m.name).size() + 3 > 32 ||
+      !is_dbc_string(m.comment) || m.length > 8) {
+    return false;
+  }
   if (periodic(m) && m.period_ms == 0) return false;
   uint64_t used_bits = 0;
   for (std::size_t i = 0; i < m.signals.size(); ++i) {
     const Signal& s = m.signals[i];
     if (!signal_is_writable(s, m.length) || (used_bits & bit_mask(s)) != 0) return false;
+    if (!enumeration_is_named(s)) return false;
     used_bits |= bit_mask(s);
     for (std::size_t j = 0; j < i; ++j) {
       if (std::string_view(s.name) == m.signals[j].name) return false;
@@ -125,6 +167,7 @@ constexpr bool table_is_writable() {
 }
 static_assert(
     table_is_writable(),
-    "firmware/protocol/messages.hpp: a name, text or bit range cannot go into a DBC file");
+    "firmware/protocol/messages.hpp: a name, text, bit range or physical range cannot go into a "
+    "DBC file, or an enumerated signal has no value table");
 
 }  // namespace imd::tools::dbc

@@ -10,7 +10,10 @@
 //   drive_monitor identify --can IFACE --node N [--rotate] [--motor-out PATH] [--timeout-s S]
 //
 // watch decodes node N's frames (default 1); the CSV's time_s is the log's timestamp, or with
-// --can the seconds since watch started. send learns the alive counter from the heartbeat.
+// --can the seconds since watch started. Everything else a shared bus carries (error frames,
+// 29-bit, CAN FD and remote frames, other nodes, unknown messages) is skipped and counted; one
+// summary line on standard error ends the watch, and a warning when node N sent nothing.
+// send learns the alive counter from the heartbeat.
 // With --repeat-hz F --for-s S (both or neither; F in (0, 1000] Hz) send sends the command
 // every 1/F s for S s, each frame with the next alive counter, and so keeps an enabled drive's
 // command watchdog fed (it needs a frame every command_timeout_s, 0.2 s by default). Acks are
@@ -22,7 +25,8 @@
 // Exit codes: 0 success (with --repeat-hz: every frame sent and accepted), 1 the CSV could not
 // be written, 2 bad input (command line, interface, log file), 3 a command frame rejected,
 // 4 no heartbeat or no acknowledgement (with --repeat-hz: none rejected, but some frame not
-// sent or unanswered).
+// sent or unanswered); for watch, no frame at all from node N (in the log, or on the bus
+// before the end of --duration-s or an interrupt).
 //
 // parameters writes the given fields (each answered after the drive has checked it: a refusal
 // prints its reason and the exit code is 3), saves the record if asked, then reads every field
@@ -49,7 +53,6 @@
 
 #include "firmware/protection/protection_config.hpp"
 #include "hal/linux/socketcan_bus.hpp"
-#include "tools/can_log/candump_log.hpp"
 #include "tools/drive_monitor/cli_io.hpp"
 #include "tools/drive_monitor/identify_cli.hpp"
 #include "tools/drive_monitor/monitor.hpp"
@@ -57,14 +60,11 @@
 #include "tools/drive_monitor/repeat_send.hpp"
 #include "tools/drive_monitor/send_command.hpp"
 #include "tools/drive_monitor/status_table.hpp"
+#include "tools/drive_monitor/watch_cli.hpp"
 
 namespace {
 
-using imd::monitor::DriveMonitor;
-using imd::monitor::TelemetryRow;
 using namespace imd::monitor::cli;
-
-constexpr auto kRefreshPeriod = std::chrono::milliseconds(200);
 
 /// A --repeat-hz rate in (0, kMaxRepeatRate_Hz].
 const CLI::Validator kRepeatRate(
@@ -80,16 +80,6 @@ const CLI::Validator kRepeatRate(
     },
     "HZ");
 
-struct WatchOptions {
-  std::string can;
-  std::string log;
-  std::string csv;
-  int node = 1;
-  bool table = false;
-  bool no_table = false;
-  double duration_s = 0.0;  ///< 0: until interrupted (live) or the end of the log
-};
-
 struct SendOptions {
   std::string can;
   int node = 1;
@@ -100,115 +90,6 @@ struct SendOptions {
   double wait_ack_s = 0.5;
   std::optional<imd::monitor::RepeatPlan> repeat;  ///< --repeat-hz/--for-s; nullopt: send once
 };
-
-/// The CSV output, when asked for ("-": standard output).
-class CsvOutput {
- public:
-  bool open(const std::string& path, std::string& error) {
-    if (path.empty()) return true;
-    if (path != "-") {
-      file_.open(path, std::ios::out | std::ios::trunc);
-      if (!file_.is_open()) {
-        error = path + ": cannot open file for writing";
-        return false;
-      }
-    }
-    stream_ = path == "-" ? &std::cout : &file_;
-    *stream_ << imd::monitor::csv_header() << '\n';
-    return true;
-  }
-  void write(const std::optional<TelemetryRow>& row) {
-    if (row && stream_ != nullptr) *stream_ << imd::monitor::csv_row(*row) << '\n';
-  }
-  /// False if a write failed.
-  bool good() { return stream_ == nullptr || static_cast<bool>(stream_->flush()); }
-
- private:
-  std::ofstream file_;
-  std::ostream* stream_ = nullptr;
-};
-
-imd::monitor::BusInfo bus_info(const imd::hal::SocketCanBus& bus) {
-  const imd::hal::CanErrorState& e = bus.errors();
-  return {e.error_frames, e.bus_off_events, e.bus_off,
-          imd::hal::describe_error_class(e.last_error_class), bus.unsupported_frames()};
-}
-
-/// Redraws the table in place: cursor home, each line cleared to its end, the rest erased.
-void redraw(const std::string& table) {
-  std::string out = "\x1b[H";
-  for (std::size_t start = 0; start < table.size();) {
-    const std::size_t end = table.find('\n', start);
-    out += table.substr(start, end - start) + "\x1b[K\n";
-    start = end == std::string::npos ? table.size() : end + 1;
-  }
-  std::cout << out << "\x1b[J" << std::flush;
-}
-
-int watch_log(const WatchOptions& o) {
-  imd::can_log::LogReader reader(o.log);
-  if (!reader.is_open()) return fail(reader.error());
-  CsvOutput csv;
-  std::string error;
-  if (!csv.open(o.csv, error)) return fail(error);
-  DriveMonitor monitor(static_cast<uint8_t>(o.node));
-  imd::can_log::ParsedLine line;
-  double first_s = -1.0;
-  while (reader.next(line)) {
-    if (first_s < 0.0) first_s = line.time_s;
-    if (o.duration_s > 0.0 && line.time_s - first_s > o.duration_s) break;
-    if (!line.remote) csv.write(monitor.feed(line.time_s, line.frame));
-  }
-  if (!reader.error().empty()) return fail(reader.error());
-  if (!csv.good()) return fail(o.csv + ": write error", kExitOutputError);
-  if (!o.no_table) {
-    std::cout << imd::monitor::render_table(monitor.status(), monitor.node_id(), o.log);
-  }
-  return 0;
-}
-
-int watch_live(const WatchOptions& o) {
-  std::string error;
-  const auto bus = imd::hal::SocketCanBus::open(o.can, error);
-  if (!bus) return fail(error);
-  CsvOutput csv;
-  if (!csv.open(o.csv, error)) return fail(error);
-  set_stop_on_signals();
-  const bool live_table = o.table || (!o.no_table && ::isatty(STDOUT_FILENO) == 1);
-  if (live_table) std::cout << "\x1b[2J";
-  DriveMonitor monitor(static_cast<uint8_t>(o.node));
-  const Clock::time_point start = Clock::now();
-  const Clock::time_point end = o.duration_s > 0.0
-                                    ? start + std::chrono::duration_cast<Clock::duration>(
-                                                  std::chrono::duration<double>(o.duration_s))
-                                    : Clock::time_point::max();
-  Clock::time_point next_refresh = start;
-  while (g_stop == 0 && Clock::now() < end) {
-    wait_readable(*bus, std::min(end, next_refresh));
-    imd::hal::CanFrame frame;
-    while (bus->try_receive(frame)) {
-      const double t_s = std::chrono::duration<double>(Clock::now() - start).count();
-      csv.write(monitor.feed(t_s, frame));
-    }
-    if (interface_lost(*bus)) {
-      return fail(o.can + ": receive failed: " + std::strerror(bus->last_errno()));
-    }
-    if (Clock::now() >= next_refresh) {
-      next_refresh = Clock::now() + kRefreshPeriod;
-      const imd::monitor::BusInfo info = bus_info(*bus);
-      if (live_table) redraw(render_table(monitor.status(), monitor.node_id(), o.can, &info));
-    }
-  }
-  const imd::monitor::BusInfo info = bus_info(*bus);
-  const std::string table = render_table(monitor.status(), monitor.node_id(), o.can, &info);
-  if (live_table) {
-    redraw(table);
-  } else if (!o.no_table) {
-    std::cout << table;
-  }
-  if (!csv.good()) return fail(o.csv + ": write error", kExitOutputError);
-  return 0;
-}
 
 /// send --repeat-hz: the frames go out on CommandRepeater's schedule; between them the loop
 /// only sleeps until the next slot, the next ack deadline or a received frame, so an ack never
@@ -308,18 +189,7 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
 
   WatchOptions w;
-  CLI::App* watch = app.add_subcommand("watch", "Decode the drive's frames: status table, CSV");
-  auto* can = watch->add_option("--can", w.can, "CAN interface (SocketCAN), e.g. can0");
-  watch->add_option("--log", w.log, "candump -L log file instead of an interface")->excludes(can);
-  watch->add_option("--node", w.node, "Node id of the drive")
-      ->check(CLI::Range(0, imd::firmware::protocol::kMaxNodeId))
-      ->capture_default_str();
-  watch->add_option("--csv", w.csv,
-                    "Write one row per fast-telemetry sample to this file ('-': stdout)");
-  auto* table = watch->add_flag("--table", w.table, "Refresh the table even if not a terminal");
-  watch->add_flag("--no-table", w.no_table, "Print no table")->excludes(table);
-  watch->add_option("--duration-s", w.duration_s, "Stop after this time (log time with --log)")
-      ->check(kSeconds);
+  CLI::App* watch = add_watch_command(app, w);
 
   SendOptions s;
   CLI::App* send_cmd = app.add_subcommand(
@@ -364,10 +234,7 @@ int main(int argc, char** argv) {
     const int code = app.exit(error);
     return code == 0 ? 0 : kExitBadInput;
   }
-  if (watch->parsed()) {
-    if (w.can.empty() && w.log.empty()) return fail("watch: give --can IFACE or --log FILE");
-    return w.log.empty() ? watch_live(w) : watch_log(w);
-  }
+  if (watch->parsed()) return run_watch(w);
   if (parameters->parsed()) return run_parameters(p);
   if (identify->parsed()) return run_identify(id);
   if (value_option->count() > 0) s.value = value;

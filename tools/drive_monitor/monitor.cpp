@@ -1,5 +1,6 @@
 #include "tools/drive_monitor/monitor.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <stdexcept>
@@ -24,7 +25,6 @@ constexpr const protocol::Signal& signal_of(MessageId id, const char* name) {
 
 namespace heartbeat {
 constexpr std::size_t kState = index_of(MessageId::heartbeat, "state");
-constexpr std::size_t kFaultBits = index_of(MessageId::heartbeat, "fault_bits");
 constexpr std::size_t kFirstFault = index_of(MessageId::heartbeat, "first_fault");
 constexpr std::size_t kCounter = index_of(MessageId::heartbeat, "counter");
 constexpr std::size_t kCommandCounter = index_of(MessageId::heartbeat, "command_counter");
@@ -37,10 +37,18 @@ constexpr std::size_t kTransitions = index_of(MessageId::heartbeat, "transitions
 
 namespace fault_report {
 constexpr std::size_t kFirstFault = index_of(MessageId::fault_report, "first_fault");
-constexpr std::size_t kFaultBits = index_of(MessageId::fault_report, "fault_bits");
 constexpr std::size_t kTime = index_of(MessageId::fault_report, "first_fault_time_ms");
 constexpr std::size_t kDetail = index_of(MessageId::fault_report, "detail");
 }  // namespace fault_report
+
+namespace version {
+constexpr std::size_t kProtocol = index_of(MessageId::version, "protocol_version");
+constexpr std::size_t kMajor = index_of(MessageId::version, "firmware_major");
+constexpr std::size_t kMinor = index_of(MessageId::version, "firmware_minor");
+constexpr std::size_t kPatch = index_of(MessageId::version, "firmware_patch");
+constexpr std::size_t kDirty = index_of(MessageId::version, "dirty");
+constexpr std::size_t kGitHash = index_of(MessageId::version, "git_hash");
+}  // namespace version
 
 namespace ack {
 constexpr std::size_t kMessage = index_of(MessageId::command_ack, "message");
@@ -156,6 +164,16 @@ std::string enum_text(const protocol::Signal& signal, int64_t raw) {
   return name != nullptr ? std::string(name) : std::to_string(raw);
 }
 
+std::string fault_bit_names(int64_t fault_bits) {
+  std::string text;
+  for (int bit = 0; bit < 63; ++bit) {
+    if (((fault_bits >> bit) & 1) == 0) continue;
+    if (!text.empty()) text += ',';
+    text += enum_text(kFirstFaultSignal, bit);
+  }
+  return text.empty() ? "none" : text;
+}
+
 std::string describe(const DecodedFrame& frame) {
   char head[64];
   switch (frame.kind) {
@@ -173,14 +191,20 @@ std::string describe(const DecodedFrame& frame) {
       break;
   }
   std::string text = frame.message->name;
+  int64_t fault_bits = -1;  // the fault bits, one word: "faults=overcurrent,encoder"
   for (std::size_t i = 0; i < frame.signal_count; ++i) {
     const SignalValue& v = frame.signals[i];
+    if (const int code = protocol::fault_code_of(*v.signal); code > 0) {
+      fault_bits = std::max<int64_t>(fault_bits, 0) | (v.raw << code);
+      continue;
+    }
     text += ' ';
     text += v.signal->name;
     text += '=';
     text +=
         v.value_name != nullptr ? std::string(v.value_name) : format_physical(*v.signal, v.value);
   }
+  if (fault_bits >= 0) text += " faults=" + fault_bit_names(fault_bits);
   return text;
 }
 
@@ -214,6 +238,7 @@ std::optional<TelemetryRow> DriveMonitor::feed(double time_s, const hal::CanFram
   switch (d.kind) {
     case FrameKind::other_node:
       ++counts.other_nodes;
+      if (d.node_id < counts.other_node_frames.size()) ++counts.other_node_frames[d.node_id];
       return std::nullopt;
     case FrameKind::unknown_message:
       ++counts.unknown;
@@ -237,7 +262,7 @@ std::optional<TelemetryRow> DriveMonitor::feed(double time_s, const hal::CanFram
       ++h.count;
       h.time_s = time_s;
       h.state = raw(heartbeat::kState);
-      h.fault_bits = raw(heartbeat::kFaultBits);
+      h.fault_bits = protocol::get_fault_bits(frame.data, protocol::kHeartbeatFaultWordBit);
       h.first_fault = raw(heartbeat::kFirstFault);
       h.counter = raw(heartbeat::kCounter);
       h.command_counter = raw(heartbeat::kCommandCounter);
@@ -252,9 +277,20 @@ std::optional<TelemetryRow> DriveMonitor::feed(double time_s, const hal::CanFram
       FaultReportStatus& f = status_.fault_report;
       ++f.count;
       f.first_fault = raw(fault_report::kFirstFault);
-      f.fault_bits = raw(fault_report::kFaultBits);
+      f.fault_bits = protocol::get_fault_bits(frame.data, protocol::kFaultReportFaultWordBit);
       f.first_fault_time_ms = raw(fault_report::kTime);
       f.detail = raw(fault_report::kDetail);
+      break;
+    }
+    case MessageId::version: {
+      VersionStatus& v = status_.version;
+      ++v.count;
+      v.protocol_version = raw(version::kProtocol);
+      v.major = raw(version::kMajor);
+      v.minor = raw(version::kMinor);
+      v.patch = raw(version::kPatch);
+      v.dirty = raw(version::kDirty) != 0;
+      v.git_hash = static_cast<uint32_t>(raw(version::kGitHash));
       break;
     }
     case MessageId::command_ack: {

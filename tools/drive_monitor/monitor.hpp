@@ -50,8 +50,13 @@ struct DecodedFrame {
 /// Decodes a frame of node `node_id` by the protocol table.
 DecodedFrame decode_frame(const hal::CanFrame& frame, uint8_t node_id);
 
-/// "name=value unit" pairs of a decoded frame, e.g. "heartbeat state=running fault_bits=0 ...".
+/// "name=value unit" pairs of a decoded frame, e.g. "heartbeat state=running ...", with the
+/// fault bits as one list of names: "faults=overcurrent,encoder" or "faults=none".
 std::string describe(const DecodedFrame& frame);
+
+/// The set bits of a fault word (bit n = fault code n) as fault names, e.g.
+/// "overcurrent,encoder"; "none".
+std::string fault_bit_names(int64_t fault_bits);
 
 /// A physical value with as many decimals as the signal's scale has (0.01 -> 2), so that the
 /// text adds no rounding to the telemetry's own resolution.
@@ -88,7 +93,7 @@ struct HeartbeatStatus {
   uint64_t count = 0;  ///< heartbeats received
   double time_s = 0.0;
   int64_t state = 0;
-  int64_t fault_bits = 0;
+  int64_t fault_bits = 0;  ///< bit n = fault code n, from the fault-bit signals
   int64_t first_fault = 0;
   int64_t counter = 0;
   int64_t command_counter = 0;
@@ -97,6 +102,15 @@ struct HeartbeatStatus {
   int64_t rejected_commands = 0;
   int64_t limited = 0;  ///< the limit that holds the drive back (0 none)
   int64_t transitions = 0;
+};
+
+/// The version frame: what the drive runs (sent once per start).
+struct VersionStatus {
+  uint64_t count = 0;
+  int64_t protocol_version = 0;
+  int64_t major = 0, minor = 0, patch = 0;
+  bool dirty = false;
+  uint32_t git_hash = 0;
 };
 
 struct AckStatus {
@@ -137,6 +151,8 @@ struct FrameCounts {
   uint64_t total = 0;
   uint64_t decoded = 0;
   uint64_t other_nodes = 0;
+  /// other_nodes by node id: whose traffic shared the bus (a wrong --node shows here).
+  std::array<uint64_t, protocol::kMaxNodeId + 1> other_node_frames{};
   uint64_t unknown = 0;
   uint64_t wrong_length = 0;
   uint64_t commands = 0;            ///< host-to-drive frames to the watched node (from any host)
@@ -149,6 +165,7 @@ struct FrameCounts {
 struct DriveStatus {
   double last_time_s = 0.0;
   HeartbeatStatus heartbeat;
+  VersionStatus version;
   AckStatus ack;
   StateChangeStatus state_change;
   FaultReportStatus fault_report;

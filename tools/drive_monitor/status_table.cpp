@@ -51,13 +51,28 @@ void add_heartbeat(std::string& out, const DriveStatus& status) {
                   status.frames.commands));
 }
 
+/// "0.1.0+ga2e14617.dirty (protocol 2)": the firmware's --version text and the protocol's.
+void add_version(std::string& out, const DriveStatus& status) {
+  const VersionStatus& v = status.version;
+  if (v.count == 0) {
+    add(out, "firmware", "(no version frame: it is sent once, at the drive's start)");
+    return;
+  }
+  add(out, "firmware",
+      fmt::format("{}.{}.{}+g{:08x}{} (protocol {}{})", v.major, v.minor, v.patch, v.git_hash,
+                  v.dirty ? ".dirty" : "", v.protocol_version,
+                  v.protocol_version == protocol::kProtocolVersion
+                      ? ""
+                      : fmt::format(", this tool speaks {}", protocol::kProtocolVersion)));
+}
+
 void add_events(std::string& out, const DriveStatus& status) {
   const FaultReportStatus& f = status.fault_report;
   if (f.count > 0) {
     add(out, "fault report",
-        fmt::format("{} at {} ms, bits 0x{:04X}, detail {} ({} reports)",
+        fmt::format("{} at {} ms, latched {}, detail {} ({} reports)",
                     enum_text(signal(MessageId::fault_report, "first_fault"), f.first_fault),
-                    f.first_fault_time_ms, f.fault_bits, f.detail, f.count));
+                    f.first_fault_time_ms, fault_bit_names(f.fault_bits), f.detail, f.count));
   }
   const AckStatus& a = status.ack;
   add(out, "last ack",
@@ -109,22 +124,12 @@ void add_telemetry(std::string& out, const DriveStatus& status) {
 
 }  // namespace
 
-std::string fault_bit_names(int64_t fault_bits) {
-  const protocol::Signal& names = signal(MessageId::heartbeat, "first_fault");
-  std::string text;
-  for (int bit = 0; bit < 63; ++bit) {
-    if (((fault_bits >> bit) & 1) == 0) continue;
-    if (!text.empty()) text += ',';
-    text += enum_text(names, bit);
-  }
-  return text.empty() ? "none" : text;
-}
-
 std::string render_table(const DriveStatus& status, uint8_t node_id, const std::string& source,
                          const BusInfo* bus) {
   std::string out = fmt::format("drive_monitor: node {} on {}, t = {:.3f} s\n", node_id, source,
                                 status.last_time_s);
   add_heartbeat(out, status);
+  add_version(out, status);
   add_events(out, status);
   add_telemetry(out, status);
   const FrameCounts& c = status.frames;

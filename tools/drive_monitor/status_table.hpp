@@ -21,7 +21,4 @@ struct BusInfo {
 std::string render_table(const DriveStatus& status, uint8_t node_id, const std::string& source,
                          const BusInfo* bus = nullptr);
 
-/// The set bits of a fault_bits value as fault names, e.g. "overcurrent,encoder"; "none".
-std::string fault_bit_names(int64_t fault_bits);
-
 }  // namespace imd::monitor

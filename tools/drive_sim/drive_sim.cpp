@@ -1,12 +1,12 @@
 // drive_sim: runs a scenario of the drive firmware on the simulated board.
 //
 //   drive_sim SCENARIO.toml [--duration-s S] [--csv PATH] [--summary-json PATH]
-//             [--plot PATH.png] [--can-log PATH] [--set table.key=VALUE]...
+//             [--plot PATH.png|.pdf|.svg] [--can-log PATH] [--set table.key=VALUE]...
 //             [--motor-file PATH] [--motor-out PATH]
 //
 // Prints the summary (JSON) on standard output. Exit codes: 0 success, 2 bad input (command
-// line or scenario file), 1 an output could not be written, 3 a commissioning run identified
-// no motor (the summary says why).
+// line or scenario file, or --plot without python3-matplotlib), 1 an output could not be
+// written, 3 a commissioning run identified no motor (the summary says why).
 #include <imd_version.hpp>
 #include <fmt/format.h>
 #include <CLI/CLI.hpp>
@@ -23,6 +23,7 @@
 #include <system_error>
 #include <vector>
 
+#include <fcntl.h>
 #include <spawn.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -35,6 +36,7 @@ extern char** environ;
 #include "hal_sim/motor_file.hpp"
 #include "hal_sim/scenario.hpp"
 #include "tools/can_log/candump_log.hpp"
+#include "tools/data_path.hpp"
 #include "tools/drive_sim/summary_json.hpp"
 
 namespace {
@@ -142,22 +144,63 @@ int report_commissioning(const imd::sim::Scenario& s, const imd::sim::Summary& r
   return 0;
 }
 
-/// The plot script for the scenario's controller: paper 000's figures or paper 001's.
+/// The plot script for the scenario's controller: paper 000's figures or paper 001's, installed
+/// beside drive_sim or in the source tree.
 std::string plot_script(const imd::sim::Scenario& scenario) {
-  const char* name = scenario.controller == "iol" ? "plot_seed001.py" : "plot_seed000.py";
-  return (std::filesystem::path(IMD_SOURCE_DIR) / "tools" / name).string();
+  const std::string name = scenario.controller == "iol" ? "plot_seed001.py" : "plot_seed000.py";
+  return imd::tools::data_file("tools/" + name, "tools/" + name).string();
 }
 
-/// Runs a program with these arguments (no shell, so no quoting) and returns its exit status.
-int run_program(std::vector<std::string> args) {
+/// Runs a program with these arguments (no shell, so no quoting) and returns its exit status;
+/// `quiet` sends its output to /dev/null.
+int run_program(std::vector<std::string> args, bool quiet = false) {
   std::vector<char*> argv;
   for (std::string& arg : args) argv.push_back(arg.data());
   argv.push_back(nullptr);
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  if (quiet) {
+    posix_spawn_file_actions_addopen(&actions, 1, "/dev/null", O_WRONLY, 0);
+    posix_spawn_file_actions_adddup2(&actions, 1, 2);
+  }
   pid_t pid = 0;
-  if (posix_spawn(&pid, argv[0], nullptr, nullptr, argv.data(), environ) != 0) return -1;
+  const int spawned = posix_spawn(&pid, argv[0], &actions, nullptr, argv.data(), environ);
+  posix_spawn_file_actions_destroy(&actions);
+  if (spawned != 0) return -1;
   int status = 0;
   if (waitpid(pid, &status, 0) < 0 || !WIFEXITED(status)) return -1;
   return WEXITSTATUS(status);
+}
+
+/// Why --plot PATH cannot be drawn, checked before the run: the format (what matplotlib's Agg
+/// backend writes, by extension) and python3 with matplotlib and numpy. Empty: it can.
+std::string plot_problem(const std::string& path) {
+  const std::string extension = std::filesystem::path(path).extension().string();
+  if (extension != ".png" && extension != ".pdf" && extension != ".svg") {
+    return fmt::format("--plot {}: the file name must end in .png, .pdf or .svg", path);
+  }
+  if (run_program({"/usr/bin/python3", "-c", "import matplotlib, numpy"}, true) != 0) {
+    return fmt::format("--plot {}: needs /usr/bin/python3 with matplotlib and numpy (Debian: "
+                       "apt install python3-matplotlib)",
+                       path);
+  }
+  return "";
+}
+
+/// --duration-s: a simulated time in (0, 3600] s, as simulation.duration_s.
+std::string duration_problem(const std::string& text) {
+  double value = 0.0;
+  try {
+    std::size_t used = 0;
+    value = std::stod(text, &used);
+    if (used != text.size()) throw std::invalid_argument(text);
+  } catch (const std::exception&) {
+    return fmt::format("{} is not a number of seconds", text);
+  }
+  if (!(value > 0.0 && value <= 3600.0)) {
+    return fmt::format("{} s: the simulated time must be > 0 and at most 3600 s", text);
+  }
+  return "";
 }
 
 }  // namespace
@@ -171,14 +214,15 @@ int main(int argc, char** argv) {
   std::vector<std::string> overrides;
   app.add_option("scenario", scenario_path, "Scenario file (TOML)")->required();
   app.add_option("--duration-s", duration_s, "Simulated duration, overrides simulation.duration_s")
-      ->check(CLI::PositiveNumber);
+      ->check(CLI::Validator(duration_problem, "SECONDS in (0, 3600]"));
   app.add_option("--csv", csv_path, "Write one row per tick to this CSV file");
   app.add_option("--summary-json", summary_path, "Write the summary to this JSON file");
   app.add_option("--plot", plot_path,
-                 "Write the paper's Figures 1-5 to this PNG (needs python3-matplotlib)");
+                 "Write the paper's figures to this .png, .pdf or .svg (needs python3-matplotlib)");
   app.add_option("--can-log", can_log_path,
-                 "Write every CAN frame the firmware sent to this file (candump -L format, "
-                 "interface can0, simulated time)");
+                 "Write every CAN frame on the bus to this file, as candump -L -x on the host's "
+                 "interface can0 logs it: the firmware's frames received (R), the scenario's "
+                 "commands transmitted (T), simulated time");
   app.add_option("--set", overrides, "Override a scenario key: table.key=VALUE (repeatable)");
   app.add_option("--motor-file", model_file,
                  "Give the controller this motor file instead of the scenario's motor; the "
@@ -195,6 +239,12 @@ int main(int argc, char** argv) {
     return code == 0 ? 0 : kExitBadInput;
   }
   if (duration_s) overrides.push_back(fmt::format("simulation.duration_s={}", *duration_s));
+  if (!plot_path.empty()) {  // before a run that may be long, not after it
+    if (const std::string problem = plot_problem(plot_path); !problem.empty()) {
+      std::cerr << "drive_sim: " << problem << '\n';
+      return kExitBadInput;
+    }
+  }
 
   imd::sim::Scenario scenario;
   try {
@@ -255,9 +305,18 @@ int main(int argc, char** argv) {
     };
   }
   if (can_log != nullptr) {
-    callbacks.can_frame = [&](double t_s, const imd::hal::CanFrame& frame) {
-      const std::string line = imd::can_log::format_log_line(t_s, "can0", frame) + "\n";
-      std::fwrite(line.data(), 1, line.size(), can_log);
+    // The log reads as candump -L -x on the host's interface: the drive's frames received,
+    // the scenario's commands transmitted.
+    const auto log_frame = [&can_log](double t_s, const imd::hal::CanFrame& frame,
+                                      imd::can_log::Direction direction) {
+      const std::string line = imd::can_log::format_log_line(t_s, "can0", frame, direction);
+      std::fprintf(can_log, "%s\n", line.c_str());
+    };
+    callbacks.can_frame = [log_frame](double t_s, const imd::hal::CanFrame& frame) {
+      log_frame(t_s, frame, imd::can_log::Direction::received);
+    };
+    callbacks.host_frame = [log_frame](double t_s, const imd::hal::CanFrame& frame) {
+      log_frame(t_s, frame, imd::can_log::Direction::transmitted);
     };
   }
   callbacks.progress = [&](double simulated_s, double wall_s) {
@@ -296,8 +355,11 @@ int main(int argc, char** argv) {
     if (status != 0) return status;
   }
   if (!plot_path.empty()) {
+    std::string title = std::filesystem::path(scenario.source).filename().string();
+    for (const std::string& o : overrides) title += " --set " + o;
     const int status = run_program({"/usr/bin/python3", plot_script(scenario), csv_path, "--out",
-                                    plot_path, "--settle-s", fmt::format("{}", scenario.settle_s)});
+                                    plot_path, "--settle-s", fmt::format("{}", scenario.settle_s),
+                                    "--title", title});
     if (temporary_csv) std::filesystem::remove(csv_path);
     if (status != 0) {
       std::cerr << "drive_sim: plotting failed (" << plot_script(scenario) << ", status " << status

@@ -16,6 +16,7 @@
 #include "hal_sim/drive/scenario_run.hpp"
 #include "hal_sim/law_variant.hpp"
 #include "hal_sim/scenario.hpp"
+#include "tools/data_path.hpp"
 #include "tools/soak/soak_host.hpp"
 
 namespace {
@@ -40,7 +41,8 @@ int main(int argc, char** argv) {
   CLI::App app{"Soak: a long simulated run under a random host and random faults, with the "
                "invariants checked every tick."};
   app.set_version_flag("--version", imd::version::kText);
-  std::string scenario_file = std::string(IMD_SOURCE_DIR) + "/hal_sim/scenarios/seed000_can.toml";
+  std::string scenario_file =  // installed beside soak, or in the source tree
+      imd::tools::data_file("scenarios/seed000_can.toml", "hal_sim/scenarios/seed000_can.toml");
   std::string law = "dsmc", precision = "double";
   double seconds = 60.0, brake_Nm = 5.0;
   uint64_t seed = 1;

@@ -7,6 +7,7 @@
 
 #include "control/motor_parameters.hpp"
 #include "firmware/drive_config.hpp"
+#include "firmware/protocol/messages.hpp"
 #include "hal/cortex_m/stm32g4/adc_injected.hpp"
 #include "hal/cortex_m/stm32g4/adc_tick.hpp"
 #include "hal/cortex_m/stm32g4/clock.hpp"
@@ -55,7 +56,12 @@ inline constexpr g4::AdcInjectedConfig kAdc{.phase_a_channel = 1,  // PA0
                                             .sampling_time_code = 2,
                                             .scale = g4::adc_scale(kAnalog)};
 inline constexpr g4::TimEncoderConfig kEncoder{.counts_per_rev = 8192};  // 2048 lines
-inline constexpr g4::FdcanConfig kCan{};                                 // 500 kbit/s from 170 MHz
+// The protocol's one bit rate from the 170 MHz FDCAN kernel clock (PCLK1).
+inline constexpr g4::FdcanConfig kCan =
+    g4::fdcan_timing(g4::kSystemClock_Hz, protocol::kNominalBitrate_bit_s);
+static_assert(g4::timing_is_exact(kCan) &&
+                  g4::nominal_bit_rate(kCan) == protocol::kNominalBitrate_bit_s,
+              "FDCAN1 must run at exactly the protocol's bit rate");
 inline constexpr g4::AdcTickConfig kTick{.core_clock_Hz = g4::kSystemClock_Hz,
                                          .period_ns = kControlPeriod_ns};
 

@@ -1,0 +1,26 @@
+#pragma once
+/// drive_monitor watch: decodes one node's frames from a CAN interface or a candump -L log into
+/// the status table and a telemetry CSV; skips and counts everything else a shared bus carries
+/// and ends with a summary line (capture_report.hpp). Exit codes: 0 success, kExitOutputError
+/// the CSV could not be written, kExitBadInput bad input (command line, interface, malformed
+/// log line), kExitNoAnswer no frame at all from the node.
+#include <CLI/CLI.hpp>
+
+#include <string>
+
+namespace imd::monitor::cli {
+
+struct WatchOptions {
+  std::string can;
+  std::string log;
+  std::string csv;
+  int node = 1;
+  bool table = false;
+  bool no_table = false;
+  double duration_s = 0.0;  ///< 0: until interrupted (live) or the end of the log
+};
+
+CLI::App* add_watch_command(CLI::App& app, WatchOptions& o);
+int run_watch(const WatchOptions& o);
+
+}  // namespace imd::monitor::cli
