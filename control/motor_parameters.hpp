@@ -11,6 +11,10 @@
 
 namespace imd::control {
 
+/// The most pole pairs a motor may have: the motor files, the drive's parameter record and the
+/// nameplate share this bound, so that any motor file can be written to a drive.
+inline constexpr int kMaxPolePairs = 32;
+
 /// Torque factor of the amplitude-invariant Clarke transform: T = 3/2 p psi x i.
 inline constexpr double kClarkeTorqueFactor = 1.5;
 

@@ -95,6 +95,11 @@ void Telemetry::publish(uint64_t k, hal::CanBus& can, const TickRecord<T>& r,
                               float(status.identify_failure), seconds}));
     }
     next_heartbeat_k_ = next_due(next_heartbeat_k_, k, ticks_per_10Hz_);
+    // Every tenth heartbeat, so that a host that joins the bus later learns the version too.
+    if (++heartbeats_since_version_ >= kHeartbeatsPerVersion) {
+      heartbeats_since_version_ = 0;
+      send_version(can);
+    }
   }
   if (k >= next_timing_k_) {  // between heartbeats, to spread the load
     next_timing_k_ = next_due(next_timing_k_, k, ticks_per_10Hz_);

@@ -2,7 +2,8 @@
 /// What the drive sends on CAN, and when (docs/can/protocol.md): the heartbeat and the timing
 /// frame at 10 Hz, fast telemetry at a configurable 10..1000 Hz (three frames per sample, the
 /// voltage frame last), and event frames for state changes, faults and command results. The
-/// version frame goes first, once per start, before whatever frame the drive sends first.
+/// version frame goes first at each start, before whatever frame the drive sends first, and
+/// then with every tenth heartbeat.
 /// Frames go to the HAL's non-blocking transmit queue; a full queue drops the frame and counts
 /// it. Tick context, no heap.
 #include <cstdint>
@@ -94,6 +95,11 @@ class Telemetry {
   uint32_t transitions_sent_ = 0;
   uint32_t dropped_ = 0;
   bool version_sent_ = false;
+  // The version frame's period in heartbeats, from the table (1000 ms / 100 ms).
+  static constexpr uint8_t kHeartbeatsPerVersion = static_cast<uint8_t>(
+      protocol::message(protocol::MessageId::version).period_ms /
+      protocol::message(protocol::MessageId::heartbeat).period_ms);
+  uint8_t heartbeats_since_version_ = 0;
 };
 
 }  // namespace imd::firmware

@@ -60,9 +60,10 @@ int require_integer(const toml::table& motor, std::string_view key, Place at) {
   const toml::node& node = require_key(motor, key, at);
   if (const auto* integer = node.as_integer()) {
     const int64_t value = integer->get();
-    if (value < 1 || value > 64) {
-      throw ConfigError(fmt::format("{}: {}.{} = {}: must be an integer in 1..64",
-                                    at.origin_of(key), at.table, key, value));
+    if (value < 1 || value > control::kMaxPolePairs) {
+      throw ConfigError(fmt::format("{}: {}.{} = {}: must be an integer in 1..{}",
+                                    at.origin_of(key), at.table, key, value,
+                                    control::kMaxPolePairs));
     }
     return static_cast<int>(value);
   }

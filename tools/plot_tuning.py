@@ -22,6 +22,8 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
+import imd_version  # noqa: E402
+
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 SCENARIO = "hal_sim/scenarios/seed000_realistic.toml"
 
@@ -115,6 +117,7 @@ def main():
     p.add_argument("--out", default=os.path.join(ROOT, "docs", "img"))
     p.add_argument("--work", help="keep the CSV and summaries here")
     p.add_argument("--duration-s", type=float, default=3.0)
+    imd_version.add_argument(p)
     a = p.parse_args()
     os.makedirs(a.out, exist_ok=True)
     work = a.work or tempfile.mkdtemp(prefix="plot_tuning_")

@@ -46,7 +46,7 @@ struct MotorRecord {
   control::MotorParameters motor;
   Nameplate nameplate;
 };
-inline constexpr int kMaxPolePairs = 32;
+using control::kMaxPolePairs;
 
 /// Why a parameter write was refused (the parameter_value message's status; 0 is accepted).
 enum class ParameterStatus : uint8_t {

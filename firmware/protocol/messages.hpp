@@ -338,8 +338,8 @@ inline constexpr Message kMessages[] = {
      100, "execution time of the tick's first four stages at 10 Hz", kStageTiming1Signals},
     {MessageId::stage_timing_2, "stage_timing_2", 8, Direction::drive_to_host, Timing::cyclic,
      100, "execution time of the tick's last four stages at 10 Hz", kStageTiming2Signals},
-    {MessageId::version, "version", 8, Direction::drive_to_host, Timing::on_event, 0,
-     "protocol and firmware version, sent once at start-up before any other frame",
+    {MessageId::version, "version", 8, Direction::drive_to_host, Timing::cyclic, 1000,
+     "protocol and firmware version: at start-up before any other frame, then at 1 Hz",
      kVersionSignals},
 };
 static_assert(std::size(kMessages) == kMessageCount, "kMessageCount counts kMessages");

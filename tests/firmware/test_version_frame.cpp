@@ -1,5 +1,6 @@
-// The version frame: the drive's first frame after every start, once, carrying the protocol
-// version and the firmware's version and git commit exactly (the 32-bit hash as raw bits).
+// The version frame: the drive's first frame after every start, then once a second (so that a
+// host joining later learns it), carrying the protocol version and the firmware's version and
+// git commit exactly (the 32-bit hash as raw bits).
 #include <gtest/gtest.h>
 #include <imd_version.hpp>
 
@@ -54,15 +55,23 @@ TEST(VersionFrame, IsTheFirstFrameAfterStartWithTheBuildsVersion) {
   EXPECT_EQ(sent[1].id, protocol::can_id(3, MessageId::heartbeat));
 }
 
-TEST(VersionFrame, IsSentOncePerStart) {
+TEST(VersionFrame, IsSentFirstAtEachStartThenOnceASecond) {
+  // 2.05 s at 10 kHz: the frame at start, then with the 10th and 20th heartbeat (1 s, 2 s).
+  constexpr int kTicks = 20500;
+  const protocol::Message& heartbeat = protocol::message(MessageId::heartbeat);
+  const int per_version = protocol::message(MessageId::version).period_ms / heartbeat.period_ms;
+  ASSERT_EQ(per_version, 10);
   for (int start = 0; start < 2; ++start) {  // a second start (a reset) sends it again
-    const std::vector<hal::CanFrame> sent = frames_after_start(10000);  // 1 s
-    int versions = 0;
+    const std::vector<hal::CanFrame> sent = frames_after_start(kTicks);
+    std::vector<int> heartbeats_before;  // how many heartbeats preceded each version frame
+    int heartbeats = 0;
     for (const hal::CanFrame& f : sent) {
-      versions += f.id == protocol::can_id(3, MessageId::version) ? 1 : 0;
+      if (f.id == protocol::can_id(3, MessageId::heartbeat)) ++heartbeats;
+      if (f.id == protocol::can_id(3, MessageId::version)) heartbeats_before.push_back(heartbeats);
     }
-    EXPECT_EQ(versions, 1) << "start " << start;
     EXPECT_EQ(sent.front().id, protocol::can_id(3, MessageId::version)) << "start " << start;
+    EXPECT_EQ(heartbeats_before, (std::vector<int>{0, per_version, 2 * per_version}))
+        << "start " << start;
   }
 }
 

@@ -97,7 +97,7 @@ TEST(MotorFile, EachBadInputHasItsOwnMessage) {
       {with_line("pole_pairs", "pole_pairs = \"2\""),
        "test.toml: motor.pole_pairs must be an integer, got a string"},
       {with_line("pole_pairs", "pole_pairs = 0"),
-       "test.toml: motor.pole_pairs = 0: must be an integer in 1..64"},
+       "test.toml: motor.pole_pairs = 0: must be an integer in 1..32"},
       {"[drive]\nsample_period_s = 1e-4\n", "test.toml: missing table [motor]"},
       {"motor = 3\n", "test.toml: motor must be a table, got an integer"},
   };

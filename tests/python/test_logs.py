@@ -115,3 +115,27 @@ def test_cli_plot_headless(realistic_log, tmp_path):
                             cwd=imdrive.__path__[0] + "/..")
     assert result.returncode == 0, result.stderr
     assert f"{SAMPLES} samples" in result.stdout and png.read_bytes()[:4] == b"\x89PNG"
+
+
+def test_shared_bus_capture_counts_as_the_cpp_monitor_does(source_dir):
+    """The checked-in capture of a shared bus (tests/data/can/shared_bus.log: candump -L -x with
+    -d). Its composition, which tests/tools/test_drive_monitor_capture.cpp counts the same way:
+    3 error frames, 3 with 29-bit ids, 2 CAN FD, 2 remote (one R8 with its raw DLC), 6 of node 2,
+    1 of an unknown message, and a DROPCOUNT line saying 2 frames were lost."""
+    bus, monitor, _ = replay(source_dir / "tests/data/can/shared_bus.log")
+    assert dict(bus.skipped) == {"error_frame": 3, "extended_id": 3, "fd_frame": 2,
+                                 "remote_frame": 2, "other_node": 6, "unknown_message": 1}
+    assert bus.dropped == 2
+    assert bus.frames == 47
+
+
+def test_remote_frame_with_raw_dlc_and_bad_dropcount(tmp_path):
+    from imdrive.logbus import parse_line
+    message = parse_line("(0.000001) can0 022#R8_C R")
+    assert message.is_remote_frame and message.dlc == 8 and message.is_rx
+    with pytest.raises(ValueError, match="raw DLC"):
+        parse_line("(0.000001) can0 022#R8_3")
+    log = tmp_path / "drop.log"
+    log.write_text("DROPCOUNT: dropped 2 CAN frames on can0 socket (total drops 2)\n")
+    with pytest.raises(imdrive.LogFormatError, match=r"drop.log:1: bad DROPCOUNT line"):
+        replay(log)

@@ -33,6 +33,9 @@ constexpr std::size_t kBusOff = index_of(MessageId::heartbeat, "can_bus_off");
 constexpr std::size_t kRejected = index_of(MessageId::heartbeat, "rejected_commands");
 constexpr std::size_t kLimited = index_of(MessageId::heartbeat, "limited");
 constexpr std::size_t kTransitions = index_of(MessageId::heartbeat, "transitions");
+constexpr std::size_t kStop = index_of(MessageId::heartbeat, "stop");
+constexpr std::size_t kBrake = index_of(MessageId::heartbeat, "brake");
+constexpr std::size_t kResetCause = index_of(MessageId::heartbeat, "reset_cause");
 }  // namespace heartbeat
 
 namespace fault_report {
@@ -271,6 +274,9 @@ std::optional<TelemetryRow> DriveMonitor::feed(double time_s, const hal::CanFram
       h.rejected_commands = raw(heartbeat::kRejected);
       h.limited = raw(heartbeat::kLimited);
       h.transitions = raw(heartbeat::kTransitions);
+      h.stop = raw(heartbeat::kStop);
+      h.brake = raw(heartbeat::kBrake) != 0;
+      h.reset_cause = raw(heartbeat::kResetCause);
       break;
     }
     case MessageId::fault_report: {

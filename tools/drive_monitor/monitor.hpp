@@ -102,9 +102,12 @@ struct HeartbeatStatus {
   int64_t rejected_commands = 0;
   int64_t limited = 0;  ///< the limit that holds the drive back (0 none)
   int64_t transitions = 0;
+  int64_t stop = 0;         ///< the latched fault's stop category (0 none)
+  bool brake = false;       ///< the holding brake is engaged
+  int64_t reset_cause = 0;  ///< why the board last started
 };
 
-/// The version frame: what the drive runs (sent once per start).
+/// The version frame: what the drive runs (sent at each start, then at 1 Hz).
 struct VersionStatus {
   uint64_t count = 0;
   int64_t protocol_version = 0;

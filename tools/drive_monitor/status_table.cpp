@@ -46,6 +46,10 @@ void add_heartbeat(std::string& out, const DriveStatus& status) {
       fmt::format("#{} ({} received), command counter {}, drive CAN bus-off {}", h.counter, h.count,
                   h.command_counter, h.can_bus_off ? "yes" : "no"));
   add(out, "limited", enum_text(signal(MessageId::heartbeat, "limited"), h.limited));
+  add(out, "stop",
+      fmt::format("{}, brake {}", enum_text(signal(MessageId::heartbeat, "stop"), h.stop),
+                  h.brake ? "engaged" : "released"));
+  add(out, "reset cause", enum_text(signal(MessageId::heartbeat, "reset_cause"), h.reset_cause));
   add(out, "commands",
       fmt::format("{} rejected (wraps at 64), {} command frames seen", h.rejected_commands,
                   status.frames.commands));
@@ -55,7 +59,7 @@ void add_heartbeat(std::string& out, const DriveStatus& status) {
 void add_version(std::string& out, const DriveStatus& status) {
   const VersionStatus& v = status.version;
   if (v.count == 0) {
-    add(out, "firmware", "(no version frame: it is sent once, at the drive's start)");
+    add(out, "firmware", "(no version frame yet: the drive sends one at start, then every second)");
     return;
   }
   add(out, "firmware",

@@ -4,7 +4,9 @@ One frame a line, as tools/can_log/candump_log.hpp writes and reads them:
     (SECONDS.MICROS) IFACE ID#HEXDATA[ DIRECTION]
 ID is 3 hex digits (11-bit) or 8 (29-bit; with bit 29 set, an error frame); `ID#R` or `ID#R<n>`
 is a remote frame, `ID##<flags><data>` a CAN FD frame, and `_<digit>` after 8 data bytes their
-raw DLC of 9..15. IFACE may be padded with spaces on its left; DIRECTION (candump -x) is R or T.
+raw DLC of 9..15 (`ID#R8_X` for a remote frame). IFACE may be padded with spaces on its left;
+DIRECTION (candump -x) is R or T. `DROPCOUNT: dropped N CAN frames on 'IFACE' socket (total
+drops M)` lines (candump -d) are counted in `dropped`.
 With `node_id` the bus hands out only
 that drive's frames of the protocol and counts the others by reason in `skipped` (error frames,
 remote, FD and 29-bit frames, other nodes, unknown messages, wrong lengths); without it, every
@@ -23,6 +25,8 @@ CAN_ERR_FLAG = 0x20000000
 _LINE_RE = re.compile(r"^\((\d{1,12})\.(\d{6})\) +(\S{1,15}) (\S+)(?: ([RT]))?$")
 _FD_LENGTHS = (0, 1, 2, 3, 4, 5, 6, 7, 8, 12, 16, 20, 24, 32, 48, 64)
 _HEX_RE = re.compile(r"^(?:[0-9A-Fa-f]{2})*$")
+_DROPCOUNT_RE = re.compile(
+    r"^DROPCOUNT: dropped (\d+) CAN frames? on '([^'\s]{1,15})' socket \(total drops \d+\)$")
 
 
 class LogFormatError(ValueError):
@@ -63,6 +67,10 @@ def parse_line(text):
                            bitrate_switch=bool(int(data_text[1], 16) & 1), **fields)
     if data_text.startswith("R"):
         rest = data_text[1:]
+        if re.fullmatch(r"8_[0-9A-Fa-f]", rest):  # 8 with a raw DLC of 9..15
+            if int(rest[2], 16) < 9:
+                raise ValueError(f"bad raw DLC in {frame!r}: '_X' follows R8, X in 9..F")
+            rest = rest[0]
         if rest and not (len(rest) == 1 and rest in "012345678"):
             raise ValueError(f"bad remote frame {data_text!r}: expected R or R<length 0..8>")
         return can.Message(arbitration_id=can_id, is_remote_frame=True,
@@ -82,8 +90,20 @@ def _hex_bytes(text, most):
     return bytes.fromhex(text)
 
 
-def read_log(path):
-    """Yields every frame of a log as python-can Messages; LogFormatError on a bad line."""
+def parse_dropcount(text):
+    """The frames a DROPCOUNT line says the capture lost, or None if it is not one."""
+    if not text.startswith("DROPCOUNT:"):
+        return None
+    match = _DROPCOUNT_RE.match(text)
+    if not match:
+        raise ValueError(f"bad DROPCOUNT line {text[:80]!r}: expected \"DROPCOUNT: dropped N "
+                         f"CAN frames on 'IFACE' socket (total drops M)\"")
+    return int(match.group(1))
+
+
+def read_log(path, on_dropped=None):
+    """Yields every frame of a log as python-can Messages; LogFormatError on a bad line.
+    `on_dropped(n)` is called for each DROPCOUNT line."""
     try:
         stream = open(path, encoding="ascii", errors="replace")
     except OSError as error:
@@ -94,7 +114,11 @@ def read_log(path):
             if not line:
                 continue
             try:
-                yield parse_line(line)
+                dropped = parse_dropcount(line)
+                if dropped is None:
+                    yield parse_line(line)
+                elif on_dropped is not None:
+                    on_dropped(dropped)
             except ValueError as error:
                 raise LogFormatError(f"{path}:{number}: {error}") from None
 
@@ -106,13 +130,17 @@ class LogReplayBus(can.BusABC):
     def __init__(self, path, node_id=None, realtime=False, **kwargs):
         super().__init__(channel=str(path), **kwargs)
         self.channel_info = f"candump -L log {path}"
-        self._frames = read_log(path)
+        self.dropped = 0  # frames the capture lost (its DROPCOUNT lines)
+        self._frames = read_log(path, on_dropped=self._count_dropped)
         self._decoder = FrameDecoder(node_id) if node_id is not None else None
         self._realtime = realtime
         self._start = None
         self.frames = 0
         self.skipped = collections.Counter()
         self.ended = False
+
+    def _count_dropped(self, frames):
+        self.dropped += frames
 
     def _recv_internal(self, timeout):
         for message in self._frames:

@@ -612,8 +612,8 @@ MESSAGES = (
                is_float=False, values=(),
                comment="publish stage of the tick before"),
     )),
-    Message(0x17, "version", length=8, direction="drive_to_host", timing="on_event", period_ms=0,
-            comment="protocol and firmware version, sent once at start-up before any other frame",
+    Message(0x17, "version", length=8, direction="drive_to_host", timing="cyclic", period_ms=1000,
+            comment="protocol and firmware version: at start-up before any other frame, then at 1 Hz",
             signals=(
         Signal("protocol_version", start_bit=0, length_bits=8, is_signed=False, scale_num=1,
                scale_den=1, offset=0.0, unit="", minimum=0.0, maximum=255.0,
