@@ -5,11 +5,13 @@ find_package(Git QUIET)
 set(hash_text "unknown")
 set(dirty 0)
 if(GIT_FOUND AND EXISTS ${SOURCE_DIR}/.git)
-  execute_process(COMMAND ${GIT_EXECUTABLE} -C ${SOURCE_DIR} rev-parse --short=8 HEAD
+  # The full hash, cut to its first 8 digits: --short may give more when 8 are ambiguous, and
+  # the frame carries exactly the first 32 bits.
+  execute_process(COMMAND ${GIT_EXECUTABLE} -C ${SOURCE_DIR} rev-parse HEAD
                   OUTPUT_VARIABLE out RESULT_VARIABLE rc OUTPUT_STRIP_TRAILING_WHITESPACE
                   ERROR_QUIET)
   if(rc EQUAL 0 AND out MATCHES "^[0-9a-f]+$")
-    set(hash_text ${out})
+    string(SUBSTRING ${out} 0 8 hash_text)
     execute_process(COMMAND ${GIT_EXECUTABLE} -C ${SOURCE_DIR} status --porcelain
                             --untracked-files=no
                     OUTPUT_VARIABLE status RESULT_VARIABLE rc ERROR_QUIET)

@@ -13,11 +13,7 @@ using protocol::MessageId;
 
 constexpr uint8_t kNoIdentification = 6;  // kIdentifyStepValues' "none"
 
-/// A signal of the table by name; a typo fails to compile (an out-of-range index).
-constexpr const protocol::Signal& signal_of(MessageId id, const char* name) {
-  const protocol::Message& m = protocol::message(id);
-  return m.signals[static_cast<std::size_t>(protocol::find_signal(m, name))];
-}
+using protocol::signal_of;
 // Counts above 2^24 do not fit a float's mantissa: these are packed as raw bits.
 constexpr const protocol::Signal& kStateChangeTime = signal_of(MessageId::state_change, "time_ms");
 constexpr const protocol::Signal& kFirstFaultTime =

@@ -32,7 +32,8 @@ def text():
     if not match:  # neither installed nor in the source tree
         return "unknown"
     version = match.group(1)
-    commit = (_git("rev-parse", "--short=8", "HEAD") or "").strip()
+    # The first 8 digits of the full hash, as cmake/WriteVersion.cmake takes them.
+    commit = (_git("rev-parse", "HEAD") or "").strip()[:8]
     if not re.fullmatch(r"[0-9a-f]+", commit):
         return f"{version}+gunknown"
     status = _git("status", "--porcelain", "--untracked-files=no")

@@ -1,5 +1,7 @@
 #!/bin/sh
-# Installs the Debian 12 packages the build and the tests need, if any is missing. Options add:
+# Installs the Debian 12 packages the build needs, if any is missing. Options add:
+#   --tests     what only the tests need: python3-can and pytest (the Python client's suite),
+#               and Node.js with the npm packages of the third-party DBC check (tools/dbc_check)
 #   --plot      the main job's plots
 #   --cortex-m  the bare-metal Cortex-M4F toolchain
 #   --fuzz      clang and its libFuzzer runtime
@@ -9,10 +11,12 @@
 # Idempotent: when everything is present it changes nothing and needs no network.
 set -eu
 packages="g++ cmake ninja-build libeigen3-dev libtomlplusplus-dev libcli11-dev nlohmann-json3-dev
-libfmt-dev libgtest-dev libbenchmark-dev libgpiod-dev python3 python3-can python3-pytest"
+libfmt-dev libgtest-dev libbenchmark-dev libgpiod-dev python3"
 arm64=no
+tests=no
 for option in "$@"; do
   case "$option" in
+    --tests) packages="$packages python3-can python3-pytest"; tests=yes ;;
     --plot) packages="$packages python3 python3-numpy python3-matplotlib" ;;
     --cortex-m) packages="$packages gcc-arm-none-eabi libnewlib-arm-none-eabi libstdc++-arm-none-eabi-newlib" ;;
     --fuzz) packages="$packages clang-14 libclang-rt-14-dev" ;;
@@ -21,13 +25,13 @@ for option in "$@"; do
     # arm64 ones need the arm64 architecture known to dpkg), cached in the build tree.
     --qemu) packages="$packages qemu-system-x86 qemu-system-arm busybox-static"; arm64=yes ;;
     --rt) packages="$packages rt-tests" ;;
-    *) echo "install_deps: unknown option $option (known: --plot, --cortex-m, --fuzz, --aarch64, --qemu, --rt)" >&2; exit 2 ;;
+    *) echo "install_deps: unknown option $option (known: --tests, --plot, --cortex-m, --fuzz, --aarch64, --qemu, --rt)" >&2; exit 2 ;;
   esac
 done
 
 # The third-party DBC check (tools/dbc_check) runs on Node.js: Debian's nodejs and npm, unless a
 # node and an npm are already on the PATH.
-if ! command -v node >/dev/null 2>&1 || ! command -v npm >/dev/null 2>&1; then
+if [ "$tests" = yes ] && { ! command -v node >/dev/null 2>&1 || ! command -v npm >/dev/null 2>&1; }; then
   packages="$packages nodejs npm"
 fi
 
@@ -54,7 +58,7 @@ fi
 
 # ...and on the npm packages its package-lock.json pins.
 dbc_check="$(cd "$(dirname "$0")" && pwd)/dbc_check"
-if [ ! -f "$dbc_check/node_modules/candied/package.json" ]; then
+if [ "$tests" = yes ] && [ ! -f "$dbc_check/node_modules/candied/package.json" ]; then
   echo "install_deps: npm ci in $dbc_check"
   npm ci --prefix "$dbc_check" --no-audit --no-fund
 fi

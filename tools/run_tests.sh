@@ -4,7 +4,7 @@
 # see tests/qemu).
 set -eu
 cd "$(dirname "$0")/.."
-tools/install_deps.sh --qemu --aarch64 --cortex-m --plot
+tools/install_deps.sh --tests --qemu --aarch64 --cortex-m --plot
 cmake --preset host
 cmake --build --preset host
 ctest --preset host --parallel 2

@@ -121,7 +121,7 @@ inline constexpr Signal kHeartbeatOwnSignals[] = {
     {"state", 0, 4, false, 1, 1, 0.0f, "", "drive state", kStateValues},
     {"first_fault", 24, 8, false, 1, 1, 0.0f, "", "first latched fault", kFaultValues},
     {"counter", 32, 8, false, 1, 1, 0.0f, "", "heartbeat count, wraps"},
-    {"command_counter", 40, 4, false, 1, 1, 0.0f, "", "alive counter of the last accepted command"},
+    {"command_counter", 40, 4, false, 1, 1, 0.0f, "", "alive counter of the last command that passed the E2E checks"},
     {"controller", 44, 2, false, 1, 1, 0.0f, "", "selected controller", kControllerValues},
     {"can_bus_off", 46, 1, false, 1, 1, 0.0f, "", "the CAN controller was bus-off"},
     {"rejected_commands", 48, 6, false, 1, 1, 0.0f, "",
@@ -143,7 +143,7 @@ inline constexpr Signal kFaultReportOwnSignals[] = {
     {"first_fault", 0, 8, false, 1, 1, 0.0f, "", "first latched fault", kFaultValues},
     {"first_fault_time_ms", 24, 32, false, 1, 1, 0.0f, "ms", "drive time of the first fault"},
     {"detail", 56, 8, false, 1, 1, 0.0f, "",
-     "phase (0..2) for overcurrent and phase loss; 3: the power stage's hardware over-current trip"},
+     "phase (0..2) for adc_offset, overcurrent and phase loss; 3: the hardware over-current trip"},
 };
 inline constexpr auto kFaultReportSignals =
     join(kFaultReportOwnSignals, fault_bit_signals(kFaultReportFaultWordBit));
@@ -365,6 +365,16 @@ constexpr const Message* find_message(uint8_t message_id) noexcept {
 }
 constexpr const Message& message(MessageId id) noexcept {
   return *find_message(uint8_t(id));
+}
+
+/// The index of a signal in its message, or -1.
+constexpr int find_signal(const Message& m, const char* name) noexcept;
+
+/// A signal of a message by name, for constants: a typo fails to compile (the index is out of
+/// range in a constant expression).
+constexpr const Signal& signal_of(MessageId id, const char* name) noexcept {
+  const Message& m = message(id);
+  return m.signals[static_cast<std::size_t>(find_signal(m, name))];
 }
 
 /// The index of a signal in its message, or -1.

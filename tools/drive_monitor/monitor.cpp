@@ -19,9 +19,7 @@ constexpr std::size_t index_of(MessageId id, const char* name) {
   return static_cast<std::size_t>(index);
 }
 
-constexpr const protocol::Signal& signal_of(MessageId id, const char* name) {
-  return protocol::message(id).signals[index_of(id, name)];
-}
+using protocol::signal_of;
 
 namespace heartbeat {
 constexpr std::size_t kState = index_of(MessageId::heartbeat, "state");

@@ -62,8 +62,10 @@ void add_version(std::string& out, const DriveStatus& status) {
     add(out, "firmware", "(no version frame yet: the drive sends one at start, then every second)");
     return;
   }
+  // A hash of 0 is a build outside a git checkout: "+gunknown", as its --version says.
+  const std::string hash = v.git_hash == 0 ? "unknown" : fmt::format("{:08x}", v.git_hash);
   add(out, "firmware",
-      fmt::format("{}.{}.{}+g{:08x}{} (protocol {}{})", v.major, v.minor, v.patch, v.git_hash,
+      fmt::format("{}.{}.{}+g{}{} (protocol {}{})", v.major, v.minor, v.patch, hash,
                   v.dirty ? ".dirty" : "", v.protocol_version,
                   v.protocol_version == protocol::kProtocolVersion
                       ? ""
