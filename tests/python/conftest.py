@@ -61,6 +61,7 @@ def fake_and_bus():
     _channel[0] += 1
     channel = f"imdrive-test-{_channel[0]}"
     fake = FakeDrive(channel)
+    fake.wait_idle()
     bus = can.Bus(interface="virtual", channel=channel)
     yield fake, bus
     bus.shutdown()

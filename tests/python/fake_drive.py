@@ -2,7 +2,12 @@
 frames as firmware/protocol/commands.cpp does (length, CRC, alive counter, ranges), answers each
 with a command_ack, runs a small state machine (idle, magnetizing, running, fault) with the
 command watchdog, and sends heartbeats and fast telemetry. It is a stand-in for the protocol's
-behaviour, not for the motor: the speed follows its reference with a first-order lag."""
+behaviour, not for the motor: the speed follows its reference with a first-order lag.
+
+It starts as firmware/telemetry.cpp does: a version frame first, then heartbeats whose counter
+runs from 0 (+1 each, wrapping at 256), in state calibrating, which it leaves for idle with a
+state_change (there is none into calibrating: it starts there); a version frame again with
+every tenth heartbeat. restart() starts it again the same way."""
 import math
 import threading
 import time
@@ -16,18 +21,22 @@ HEARTBEAT_S = 0.1
 TELEMETRY_S = 0.01
 WATCHDOG_S = 0.2
 MAGNETIZING_S = 0.05
+CALIBRATING_S = 0.05       # a stand-in for the firmware's ADC offset calibration
+HEARTBEATS_PER_VERSION = 10  # the version frame's 1 s over the heartbeat's 0.1 s
 SPEED_TAU_S = 0.05
 PLANT_FLUX2_WB2 = 0.2
 
 
 class FakeDrive:
-    def __init__(self, channel, node_id=1, watchdog=True):
+    def __init__(self, channel, node_id=1, watchdog=True, protocol_version=None):
         self.bus = can.Bus(interface="virtual", channel=channel)
         self.node_id = node_id
         self.watchdog = watchdog
+        self.protocol_version = table.PROTOCOL_VERSION if protocol_version is None \
+            else protocol_version
         self.silent = False        # no acks, no frames at all
+        self.heartbeats = True     # False: its heartbeats are lost (the rest still comes)
         self.refuse = None         # a result name every valid command gets instead of accepted
-        self.state = "idle"
         self.first_fault = "none"
         self.speed_ref = 0.0
         self.speed = 0.0
@@ -39,8 +48,11 @@ class FakeDrive:
         self.saved = False
         self.identify_start = None
         self.received = []         # (message name, result) of every command frame
+        self.arrivals = []         # (time.monotonic(), message name, counter) of each one
         self._stop = threading.Event()
         self._lock = threading.Lock()
+        with self._lock:
+            self._start()
         self._threads = [threading.Thread(target=self._receive, daemon=True),
                          threading.Thread(target=self._run, daemon=True)]
         for t in self._threads:
@@ -53,12 +65,28 @@ class FakeDrive:
         self.bus.shutdown()
 
     def restart(self):
-        """A power cycle: no counter reference, idle, faults cleared."""
+        """A power cycle: no counter reference, faults cleared, calibrating, then idle."""
         with self._lock:
-            self.last_counter = None
-            self.state, self.first_fault, self.speed_ref, self.speed = "idle", "none", 0.0, 0.0
-            self._send("state_change", **{"from": "idle", "to": "calibrating",
-                                          "reason": "calibrated"})
+            self._start()
+
+    def _start(self):
+        self.last_counter = None
+        self.state, self.first_fault, self.speed_ref, self.speed = "calibrating", "none", 0.0, 0.0
+        self.calibrated_at = time.monotonic() + CALIBRATING_S
+        self.hb_counter = self.since_version = 0
+        self.next_hb = time.monotonic()  # the first heartbeat at once, after the version
+        self._version()
+
+    def _version(self):
+        self._send("version", protocol_version=self.protocol_version, firmware_major=0,
+                   firmware_minor=1, firmware_patch=0, dirty=False, git_hash=0x1234ABCD)
+
+    def wait_idle(self, timeout_s=2.0):
+        """Waits until it has calibrated (the tests start on a drive that has)."""
+        deadline = time.monotonic() + timeout_s
+        while self.state == "calibrating" and time.monotonic() < deadline:
+            time.sleep(TICK_S)
+        assert self.state == "idle", f"the fake drive is still {self.state}"
 
     def _send(self, name, **values):
         if not self.silent:
@@ -83,6 +111,7 @@ class FakeDrive:
     def _command(self, msg, m):
         data = bytearray(m.data).ljust(8, b"\0")
         counter = e2e.e2e_counter(data)
+        self.arrivals.append((time.monotonic(), msg.name, counter))
         if m.dlc != msg.length:
             return self._ack(msg, counter, "wrong_length")
         if not e2e.e2e_check(m.arbitration_id, data, m.dlc):
@@ -165,7 +194,7 @@ class FakeDrive:
             self._go("fault", "fault")
 
     def _run(self):
-        next_hb = next_tm = time.monotonic()
+        next_tm = time.monotonic()
         while not self._stop.wait(TICK_S):
             now = time.monotonic()
             with self._lock:
@@ -173,16 +202,26 @@ class FakeDrive:
                 if now >= next_tm:
                     next_tm += TELEMETRY_S
                     self._telemetry()
-                if now >= next_hb:
-                    next_hb += HEARTBEAT_S
-                    bit = f"fault_{self.first_fault}"  # the table's one-bit fault signals
-                    hb = table.message("heartbeat")
-                    fault_bits = {bit: True} if table.find_signal(hb, bit) else {}
-                    self._send("heartbeat", state=self.state, first_fault=self.first_fault,
-                               command_counter=self.last_counter or 0,
-                               controller=self.controller, **fault_bits)
+                if now >= self.next_hb:
+                    self.next_hb += HEARTBEAT_S
+                    self._heartbeat()
+
+    def _heartbeat(self):
+        # The table's one-bit fault signals: fault_<name> (none for code 0).
+        bits = {f"fault_{self.first_fault}": True} if self.first_fault != "none" else {}
+        if self.heartbeats:
+            self._send("heartbeat", state=self.state, first_fault=self.first_fault,
+                       counter=self.hb_counter, command_counter=self.last_counter or 0,
+                       controller=self.controller, **bits)
+        self.hb_counter = (self.hb_counter + 1) % 256
+        self.since_version += 1
+        if self.since_version >= HEARTBEATS_PER_VERSION:
+            self.since_version = 0
+            self._version()
 
     def _step(self, now):
+        if self.state == "calibrating" and now >= self.calibrated_at:
+            self._go("idle", "calibrated")
         if self.state == "magnetizing" and now - self.enabled_at > MAGNETIZING_S:
             self._go("running", "magnetized")
         if self.state in ("magnetizing", "running") and self.watchdog and \

@@ -1,5 +1,8 @@
 """The command line: --version, clear errors for bad flags and values, and send / param /
 identify against the fake drive (in-process: the virtual bus lives in this process)."""
+import importlib.util
+import re
+import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -17,11 +20,62 @@ def cli(*args):
                           text=True, cwd=PACKAGE_DIR)
 
 
-def test_version_is_the_projects(source_dir):
+def _load_imd_version(source_dir):
+    path = source_dir / "tools/imd_version.py"
+    spec = importlib.util.spec_from_file_location("imd_version", path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_version_is_the_builds_as_every_tool_prints_it(source_dir):
+    """From the source tree: what tools/imd_version.py prints for the other tools,
+    0.1.0+g<commit>[.dirty], the project() version first."""
     cmake = (source_dir / "CMakeLists.txt").read_text()
     version = cmake.split("project(imdrive VERSION ")[1].split()[0]
     result = cli("--version")
-    assert result.returncode == 0 and result.stdout.strip() == f"imdrive {version}"
+    assert result.returncode == 0, result.stderr
+    assert result.stdout.strip() == _load_imd_version(source_dir).text()
+    assert re.fullmatch(re.escape(version) + r"\+g([0-9a-f]{8}|unknown)(\.dirty)?",
+                        result.stdout.strip())
+
+
+def test_version_installed_and_bare(source_dir, tmp_path):
+    """Installed as cmake/Install.cmake lays it out, with the build's version text; and the
+    package alone (as the qemu test ships it): the table's version."""
+    installed = tmp_path / "prefix"
+    shutil.copytree(PACKAGE_DIR / "imdrive", installed / "lib/python3/dist-packages/imdrive")
+    tools = installed / "share/imdrive/tools"
+    tools.mkdir(parents=True)
+    shutil.copy(source_dir / "tools/imd_version.py", tools)
+    (tools / "imd_version.txt").write_text("0.1.0+g0123abcd.dirty\n")
+    bare = tmp_path / "bare"
+    shutil.copytree(PACKAGE_DIR / "imdrive", bare / "imdrive")
+    for where, expected in ((installed / "lib/python3/dist-packages", "0.1.0+g0123abcd.dirty"),
+                            (bare, imdrive.__version__)):
+        result = subprocess.run([sys.executable, "-B", "-m", "imdrive", "--version"],
+                                capture_output=True, text=True, cwd=where)
+        assert result.returncode == 0 and result.stdout.strip() == expected, result.stderr
+
+
+def test_watch_a_shared_bus_capture_counts_every_frame(source_dir, capsys):
+    """tests/data/can/shared_bus.log, whose composition test_logs.py lists: the summary counts
+    what drive_monitor's does (docs/can/protocol.md quotes its line), and the 2 lost frames."""
+    assert main(["watch", "--log", str(source_dir / "tests/data/can/shared_bus.log")]) == 0
+    err = capsys.readouterr().err
+    assert ("imdrive: 47 frames: 30 decoded (26 from node 1, 4 commands to it), 5 samples; "
+            "skipped: 3 error frames, 3 with 29-bit ids, 2 CAN FD, 2 remote, 6 of other nodes "
+            "(node 2: 6), 1 of unknown messages, 0 of wrong length; the capture lost 2 frames"
+            in err), err
+
+
+def test_watch_of_a_silent_node_warns_and_exits_4(source_dir, capsys):
+    log = source_dir / "tests/data/can/node2_only.log"
+    assert main(["watch", "--log", str(log)]) == 4
+    err = capsys.readouterr().err
+    assert f"imdrive: warning: no frame from node 1 on {log}; heard only other nodes " \
+           f"(node 2: 7): is --node right?" in err, err
+    assert main(["watch", "--log", str(log), "--node", "2"]) == 0
 
 
 @pytest.mark.parametrize("args, message", [
@@ -62,3 +116,19 @@ def test_send_param_identify_on_the_fake(fake_and_bus, capsys):
     fake.refuse = "not_allowed"
     assert main(["send", *common, "enable"], Out()) == 3
     assert "rejected: not_allowed" in capsys.readouterr().err
+
+
+def test_watch_warns_of_a_drive_on_another_protocol(tmp_path, capsys):
+    from imdrive import frames, table
+
+    def line(time_s, message):
+        return f"({time_s:.6f}) can0 {message.arbitration_id:03X}#{message.data.hex().upper()}"
+    log = tmp_path / "other_protocol.log"
+    log.write_text("\n".join([
+        line(0.0, frames.encode_message("version", 1, protocol_version=table.PROTOCOL_VERSION + 1,
+                                        firmware_minor=2, git_hash=0xA2E14617)),
+        line(0.0001, frames.encode_message("heartbeat", 1, state="calibrating"))]) + "\n")
+    assert main(["watch", "--log", str(log)]) == 0
+    assert (f"imdrive: warning: node 1 speaks protocol {table.PROTOCOL_VERSION + 1} (firmware "
+            f"0.2.0+ga2e14617), this client protocol {table.PROTOCOL_VERSION}"
+            in capsys.readouterr().err)

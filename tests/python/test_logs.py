@@ -87,7 +87,9 @@ def test_cli_watch_writes_csv(realistic_log, tmp_path, capsys):
     csv_path = tmp_path / "watch.csv"
     assert main(["watch", "--log", str(realistic_log), "--csv", str(csv_path)]) == 0
     assert len(csv_path.read_text().splitlines()) == SAMPLES + 1
-    assert f"{SAMPLES} samples, skipped: none" in capsys.readouterr().out
+    err = capsys.readouterr().err
+    assert (f"), {SAMPLES} samples; skipped: 0 error frames, 0 with 29-bit ids, 0 CAN FD, "
+            f"0 remote, 0 of other nodes, 0 of unknown messages, 0 of wrong length\n") in err, err
 
 
 def test_plot_saves_a_png_of_the_log(realistic_log, tmp_path):

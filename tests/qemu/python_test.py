@@ -2,7 +2,7 @@
 """The qemu tier's Python client test: boots Debian's x86_64 kernel (qemu_guest.py) with the
 static drive_hil, the host's Python interpreter and python3-can (python_bundle.py) and the
 imdrive package, and checks that the client, over vcan0, finds the drive idle, reads a
-parameter, enables it, sets a speed and reads it back from telemetry, sees the command
+parameter, enables it, sets a speed and sees it held in telemetry, sees the command
 watchdog trip by name when it stops commanding, and an emergency stop latched by name.
 
 usage: python_test.py --bin-dir DIR --source-dir DIR --cache DIR --work DIR

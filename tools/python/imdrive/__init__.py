@@ -12,7 +12,8 @@ dbc_gen --python, the same table the firmware and docs/can/drive.dbc come from.
 from ._version import __version__
 from .commands import CommandEncoder
 from .drive import Drive
-from .errors import CommandRejected, DriveError, IdentifyFailed, NoAnswer, ParameterRefused
+from .errors import (CommandRejected, DriveError, IdentifyFailed, NoAnswer, ParameterRefused,
+                     ProtocolMismatch)
 from .frames import FrameDecoder
 from .logbus import LogFormatError, LogReplayBus, read_log
 from .monitor import Monitor
@@ -21,4 +22,5 @@ from .telemetry import TelemetrySample
 
 __all__ = ["__version__", "CommandEncoder", "CommandRejected", "Drive", "DriveError",
            "FrameDecoder", "IdentifyFailed", "LogFormatError", "LogReplayBus", "Monitor",
-           "NoAnswer", "ParameterRefused", "TelemetrySample", "active_faults", "read_log"]
+           "NoAnswer", "ParameterRefused", "ProtocolMismatch", "TelemetrySample",
+           "active_faults", "read_log"]

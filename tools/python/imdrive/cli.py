@@ -2,7 +2,7 @@
 
 Exit codes, as drive_monitor's: 0 success, 2 bad input (flags, values, interface, log file),
 3 the drive refused (a command rejected, a parameter refused, an identification failed), 4 no
-answer in time.
+answer in time (watch: no frame at all from the node).
 """
 import argparse
 import math
@@ -11,7 +11,8 @@ import time
 
 import can
 
-from . import __version__, table
+from . import capture_report, table
+from ._version import build_version
 from .drive import Drive
 from .errors import CommandRejected, DriveError, IdentifyFailed, NoAnswer, ParameterRefused
 from .logbus import LogFormatError, LogReplayBus
@@ -71,7 +72,7 @@ def _bus_options(parser, log=False):
 def parser():
     p = argparse.ArgumentParser(prog="imdrive", description="Watch and command the "
                                 "induction-motor drive over CAN (python-can).")
-    p.add_argument("--version", action="version", version=f"imdrive {__version__}")
+    p.add_argument("--version", action="version", version=build_version())
     sub = p.add_subparsers(dest="command", required=True, metavar="COMMAND")
     w = sub.add_parser("watch", help="print telemetry samples (or write them as CSV)")
     _bus_options(w, log=True)
@@ -105,9 +106,10 @@ def parser():
 
 
 def open_bus(args):
-    """The bus the flags name; UsageError says why it cannot be opened."""
+    """The bus the flags name; UsageError says why it cannot be opened. A log is read whole:
+    the Monitor decodes the node's frames and counts the others, by reason and by node."""
     if getattr(args, "log", None):
-        return LogReplayBus(args.log, node_id=args.node)
+        return LogReplayBus(args.log)
     if args.interface and not args.channel:
         raise UsageError(f"--interface {args.interface} needs --channel")
     interface, channel = ("socketcan", args.can) if args.can else (args.interface, args.channel)
@@ -167,13 +169,23 @@ def run_watch(args, out):
         if csv and csv is not sys.stdout:
             csv.close()
         bus.shutdown()
+    return finish_watch(monitor, samples, bus, args)
+
+
+def finish_watch(monitor, samples, bus, args):
+    """The summary on standard error, as drive_monitor's; 4 when the node was not heard."""
+    print(f"imdrive: {capture_report.summary_line(monitor, samples, bus)}", file=sys.stderr)
     hb = monitor.heartbeat()
-    skipped = ", ".join(f"{n} {r}" for r, n in sorted(monitor.skipped.items())) or "none"
-    out.write(f"node {args.node}: {monitor.decoder.decoded} frames decoded, {samples} samples, "
-              f"skipped: {skipped}\n")
     if hb is not None:
-        out.write(f"state {hb.state}, first fault {hb.first_fault}, latched: "
-                  f"{', '.join(active_faults(hb)) or 'none'}\n")
+        print(f"imdrive: node {args.node}: state {hb.state}, first fault {hb.first_fault}, "
+              f"latched: {', '.join(active_faults(hb)) or 'none'}", file=sys.stderr)
+    if monitor.protocol_error is not None:
+        print(f"imdrive: warning: {monitor.protocol_error}", file=sys.stderr)
+    source = args.log or args.can or f"{args.interface} {args.channel}"
+    warning = capture_report.silent_node_warning(monitor, source)
+    if warning is not None:
+        print(f"imdrive: {warning}", file=sys.stderr)
+        return EXIT_NO_ANSWER
     return 0
 
 

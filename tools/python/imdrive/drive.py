@@ -3,8 +3,14 @@
 A receive thread feeds every frame to a Monitor; commands are sent from the caller's thread
 with the next alive counter and wait for their command_ack. The counter is learnt from the
 heartbeat's command_counter before the first command, and learnt again when the drive rejects
-a frame for its counter (another host sent in between, frames were lost, the drive restarted):
-the frame is then sent once more with the counter the next heartbeat gives.
+a frame for its counter (another host sent in between, frames were lost): the frame is then
+sent once more with the counter the next heartbeat gives. It is learnt again too when the drive
+restarts (startup.py says how a restart shows). The counter state is shared by the caller and
+the keep-alive thread: it is read and written under the drive's lock, one thread learns it at a
+time, and a frame is encoded and sent under one lock, so that frames leave in counter order.
+
+A version frame whose protocol is not the client's table makes every later command and wait
+raise ProtocolMismatch: the drive's frames would decode wrongly.
 
 While the drive is enabled from CAN, its command watchdog trips (command_timeout) unless a
 valid command comes every command_timeout_s (0.2 s by default): enable() therefore starts a
@@ -20,7 +26,7 @@ import can
 
 from . import table
 from .commands import CommandEncoder
-from .errors import CommandRejected, DriveError, NoAnswer
+from .errors import CommandRejected, DriveError, NoAnswer, ProtocolMismatch
 from .keepalive import KeepAlive
 from .monitor import Monitor
 from .service import ParameterService
@@ -47,8 +53,10 @@ class Drive(ParameterService):
         self.answer_timeout_s = answer_timeout_s
         self.monitor = Monitor(node_id)
         self._encoder = CommandEncoder(node_id)
-        self._synced = False
-        self._changed = threading.Condition()
+        self._synced = False  # whether the encoder's counter is the drive's; under _changed
+        self._changed = threading.Condition()  # the lock of everything the threads share
+        self._learning = threading.Lock()  # one thread learns the counter at a time
+        self._sending = threading.Lock()  # encode and send as one step: frames in counter order
         self._waiting = {}  # (message id, counter) -> command_ack frame or None
         self._samples = collections.deque(maxlen=self.SAMPLE_QUEUE)
         self._frames = collections.deque(maxlen=self.SAMPLE_QUEUE)
@@ -91,10 +99,13 @@ class Drive(ParameterService):
                 if getattr(self.bus, "ended", False):  # a log replay at its end
                     return
                 continue
+            restarts = self.monitor.restarts
             frame, sample = self.monitor.feed(message)
             if frame is None:
                 continue
             with self._changed:
+                if self.monitor.restarts != restarts:
+                    self._synced = False  # the drive started again: learn the counter anew
                 self._dispatch(frame, sample)
                 self._changed.notify_all()
 
@@ -112,12 +123,14 @@ class Drive(ParameterService):
                 self._waiting[key] = frame
             else:
                 self.keep_alive.on_ack(frame)
-        elif name == "state_change" and frame.to == "calibrating":
-            self._synced = False  # the drive started again: learn the counter anew
 
     def _check_bus(self):
+        """Raises what makes waiting pointless: a dead bus, a drive on another protocol."""
         if self._bus_error is not None:
             raise DriveError(f"node {self.node_id}: the bus failed: {self._bus_error}")
+        mismatch = self.monitor.protocol_error
+        if mismatch is not None:
+            raise ProtocolMismatch(str(mismatch), mismatch.drive, mismatch.client)
 
     def wait(self, predicate, timeout_s, what):
         """Waits until predicate() (called under the lock) is true; NoAnswer(what) on timeout."""
@@ -148,6 +161,16 @@ class Drive(ParameterService):
     def state(self):
         """The drive state's name from the latest heartbeat, or None."""
         return getattr(self.heartbeat, "state", None)
+
+    @property
+    def version(self):
+        """The latest Version frame (protocol_version, firmware_major, ...), or None."""
+        return self.monitor.version()
+
+    @property
+    def restarts(self):
+        """How many times the drive was seen to start again since the client started."""
+        return self.monitor.restarts
 
     # --- telemetry
 
@@ -214,43 +237,64 @@ class Drive(ParameterService):
 
     # --- commands
 
-    def _sync_counter(self):
-        hb = self.wait_heartbeat() if self.heartbeat is None or not self._synced else None
-        hb = hb or self.heartbeat
-        counter = getattr(hb, "command_counter", None)
-        # A table without command_counter: start anywhere; a rejection tells the truth.
-        self._encoder.next_counter = (counter + 1) if isinstance(counter, int) else 0
-        self._synced = True
+    def forget_counter(self):
+        """Makes the next command learn the alive counter from a heartbeat first."""
+        with self._changed:
+            self._synced = False
+
+    def learn_counter(self):
+        """Unless known, learns the alive counter: the command_counter of the next heartbeat
+        + 1. One thread learns; one that waited meanwhile finds it learnt."""
+        with self._learning:
+            with self._changed:
+                if self._synced:
+                    return
+                seen = self._heartbeats
+            hb = self.wait(lambda: self._heartbeats > seen and self.monitor.heartbeat(),
+                           max(self.answer_timeout_s, 0.5), "no heartbeat")
+            counter = getattr(hb, "command_counter", None)
+            with self._changed:
+                # A table without command_counter: start anywhere; a rejection tells the truth.
+                self._encoder.next_counter = (counter + 1) if isinstance(counter, int) else 0
+                self._synced = True
 
     def send(self, message_name, wait_ack=True, **values):
         """Sends command `message_name` with `values` (by signal name) and, with wait_ack,
         returns its command_ack frame; CommandRejected names the result, NoAnswer a timeout.
         A counter rejection is retried once on the counter the next heartbeat gives."""
+        return self._send(message_name, wait_ack, values)
+
+    def _send(self, message_name, wait_ack, values, cancelled=None):
+        """send(); with `cancelled` (a function), nothing goes out once it returns True: False."""
+        with self._changed:
+            self._check_bus()  # a drive on another protocol gets no command
         for attempt in (1, 2):
-            if not self._synced:
-                self._sync_counter()
-            ack = self._send_once(message_name, wait_ack, values)
-            if ack is None or ack.result == "accepted":
+            self.learn_counter()
+            ack = self._send_once(message_name, wait_ack, values, cancelled)
+            if ack in (None, False) or ack.result == "accepted":
                 return ack
             if ack.result in COUNTER_RESULTS and attempt == 1:
-                self._synced = False
-                self.wait_heartbeat()  # one sent after the rejection: the drive's reference
+                self.forget_counter()  # the next heartbeat carries the drive's reference
                 continue
             raise CommandRejected(
                 f"node {self.node_id}: {message_name} {_values_text(values)}rejected: "
                 f"{ack.result}", message_name, ack.counter, ack.result)
 
-    def _send_once(self, message_name, wait_ack, values):
-        frame = self._encoder.encode(message_name, **values)
-        key = (table.message_id_of(frame.arbitration_id), frame.data[1] & 0x0F)
-        with self._changed:
-            self._waiting[key] = None
-        try:
-            self.bus.send(frame)
-        except can.CanError as error:
+    def _send_once(self, message_name, wait_ack, values, cancelled=None):
+        with self._sending:
+            if cancelled is not None and cancelled():
+                return False
+            frame = self._encoder.encode(message_name, **values)
+            key = (table.message_id_of(frame.arbitration_id), frame.data[1] & 0x0F)
             with self._changed:
-                self._waiting.pop(key, None)
-            raise DriveError(f"node {self.node_id}: cannot send {message_name}: {error}") from None
+                self._waiting[key] = None
+            try:
+                self.bus.send(frame)
+            except can.CanError as error:
+                with self._changed:
+                    self._waiting.pop(key, None)
+                raise DriveError(
+                    f"node {self.node_id}: cannot send {message_name}: {error}") from None
         if not wait_ack:
             with self._changed:
                 self._waiting.pop(key, None)
@@ -274,9 +318,23 @@ class Drive(ParameterService):
         return self.send("disable")
 
     def emergency_stop(self):
-        """PWM off at once, latched as fault emergency_stop (obeyed whatever the counter)."""
+        """PWM off at once, latched as fault emergency_stop. The drive obeys it whatever its
+        counter (firmware/protocol/commands.cpp) and takes that counter as its reference, so it
+        goes out at once with the counter the client holds, learnt or not: no heartbeat is
+        waited for. The keep-alive is told to stop first (no frame of it follows the stop) but
+        not waited for. Then the ack is awaited; without one the stop is sent once more."""
+        self.keep_alive.signal_stop()
+        try:
+            ack = self._send_once("emergency_stop", True, {})
+        except NoAnswer:
+            ack = self._send_once("emergency_stop", True, {})
+        if ack.result != "accepted":  # only a garbled frame can be refused
+            raise CommandRejected(f"node {self.node_id}: emergency_stop rejected: {ack.result}",
+                                  "emergency_stop", ack.counter, ack.result)
+        with self._changed:
+            self._synced = True  # the drive's reference is the stop's counter now
         self.keep_alive.stop()
-        return self.send("emergency_stop")
+        return ack
 
     def clear_faults(self):
         return self.send("clear_faults")

@@ -39,3 +39,13 @@ class IdentifyFailed(DriveError):
         super().__init__(text)
         self.failure = failure
         self.progress = progress
+
+
+class ProtocolMismatch(DriveError):
+    """The drive's version frame names another protocol version than this client's table: its
+    frames would decode wrongly. `drive` and `client` are the two protocol versions."""
+
+    def __init__(self, text, drive, client):
+        super().__init__(text)
+        self.drive = drive
+        self.client = client

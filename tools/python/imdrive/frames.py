@@ -89,14 +89,18 @@ SKIP_REASONS = ("error_frame", "remote_frame", "fd_frame", "extended_id", "other
 
 
 class FrameDecoder:
-    """Decodes one node's frames (python-can Messages); counts the others by reason."""
+    """Decodes one node's frames (python-can Messages); counts the others by reason, and those
+    of other nodes by node. `decoded` includes the commands other hosts sent to the node
+    (`commands`): the frames from the drive itself are decoded - commands."""
 
     def __init__(self, node_id):
         if not 0 <= node_id <= table.MAX_NODE_ID:
             raise ValueError(f"node id {node_id}: must be in 0..{table.MAX_NODE_ID}")
         self.node_id = node_id
         self.decoded = 0
+        self.commands = 0
         self.skipped = collections.Counter()
+        self.other_nodes = collections.Counter()  # node id -> its frames
 
     def skip_reason(self, message):
         """Why a frame is not one of this node's protocol frames, or None."""
@@ -122,9 +126,12 @@ class FrameDecoder:
         reason = self.skip_reason(message)
         if reason is not None:
             self.skipped[reason] += 1
+            if reason == "other_node":
+                self.other_nodes[table.node_of(message.arbitration_id)] += 1
             return None
         msg = table.message_by_id(table.message_id_of(message.arbitration_id))
         self.decoded += 1
+        self.commands += table.is_command(msg)
         return decode_payload(msg, message.data, float(message.timestamp), self.node_id)
 
 

@@ -3,7 +3,8 @@ CAN, so that its command watchdog (command_timeout_s, 0.2 s by default) stays fe
 
 Frames go out without waiting for their acks (a stop-and-wait at 20 Hz would stall on one lost
 ack); the acks that come back are tallied by result in `results`. A counter rejection makes the
-client learn the counter again from the next heartbeat before the next frame."""
+client learn the counter again from the next heartbeat before the next frame. Once told to stop
+(signal_stop, stop) it sends no further frame: the emergency stop relies on it."""
 import collections
 import threading
 
@@ -37,7 +38,12 @@ class KeepAlive:
                                         name=f"imdrive-keepalive-{self._drive.node_id}")
         self._thread.start()
 
+    def signal_stop(self):
+        """Stops it without waiting for its thread: no frame of it goes out after this call."""
+        self._stop.set()
+
     def stop(self):
+        """Stops it and waits for its thread to end."""
         self._stop.set()
         if self.running and self._thread is not threading.current_thread():
             self._thread.join(timeout=2.0)
@@ -46,15 +52,17 @@ class KeepAlive:
         """A command_ack nobody waited for (called under the drive's lock)."""
         self.results[ack.result] += 1
         if ack.result in ("repeated_counter", "stale_counter"):
-            self._drive._synced = False
+            self._drive.forget_counter()
 
     def _run(self):
         while not self._stop.wait(self.period_s):
             try:
-                if not self._drive._synced:
-                    self._drive._sync_counter()
-                self._drive.send("set_speed", wait_ack=False, speed_ref_rad_s=self.speed_rad_s)
-                self.sent += 1
+                # The drive checks the stop under its send lock, after any wait for a heartbeat.
+                sent = self._drive._send("set_speed", False, {"speed_ref_rad_s": self.speed_rad_s},
+                                         cancelled=self._stop.is_set)
             except DriveError as error:
                 self.error = error
                 return
+            if sent is False:
+                return
+            self.sent += 1

@@ -2,11 +2,14 @@
 
 One frame a line, as tools/can_log/candump_log.hpp writes and reads them:
     (SECONDS.MICROS) IFACE ID#HEXDATA[ DIRECTION]
+with 6 digits after the point, or 9 (nanoseconds, as candump -N writes).
 ID is 3 hex digits (11-bit) or 8 (29-bit; with bit 29 set, an error frame); `ID#R` or `ID#R<n>`
 is a remote frame, `ID##<flags><data>` a CAN FD frame, and `_<digit>` after 8 data bytes their
 raw DLC of 9..15 (`ID#R8_X` for a remote frame). IFACE may be padded with spaces on its left;
-DIRECTION (candump -x) is R or T. `DROPCOUNT: dropped N CAN frames on 'IFACE' socket (total
-drops M)` lines (candump -d) are counted in `dropped`.
+DIRECTION (candump -x) is R or T. `DROPCOUNT: dropped N CAN frames on 'ARG' socket (total
+drops M)` lines (candump -d) are counted in `dropped`; ARG is candump's argument as given, which
+Debian 12's can-utils writes with its filters (`'can0,020:7E0,7FF:7FF'`), so anything up to
+`' socket (total drops` is taken.
 With `node_id` the bus hands out only
 that drive's frames of the protocol and counts the others by reason in `skipped` (error frames,
 remote, FD and 29-bit frames, other nodes, unknown messages, wrong lengths); without it, every
@@ -22,11 +25,11 @@ import can
 from .frames import FrameDecoder
 
 CAN_ERR_FLAG = 0x20000000
-_LINE_RE = re.compile(r"^\((\d{1,12})\.(\d{6})\) +(\S{1,15}) (\S+)(?: ([RT]))?$")
+_LINE_RE = re.compile(r"^\((\d{1,12})\.(\d{6}|\d{9})\) +(\S{1,15}) (\S+)(?: ([RT]))?$")
 _FD_LENGTHS = (0, 1, 2, 3, 4, 5, 6, 7, 8, 12, 16, 20, 24, 32, 48, 64)
 _HEX_RE = re.compile(r"^(?:[0-9A-Fa-f]{2})*$")
 _DROPCOUNT_RE = re.compile(
-    r"^DROPCOUNT: dropped (\d+) CAN frames? on '([^'\s]{1,15})' socket \(total drops \d+\)$")
+    r"^DROPCOUNT: dropped (\d+) CAN frames? on '(.*)' socket \(total drops \d+\)$")
 
 
 class LogFormatError(ValueError):
@@ -37,9 +40,10 @@ def parse_line(text):
     """A python-can Message from one candump -L line; ValueError says what is wrong."""
     match = _LINE_RE.match(text)
     if not match:
-        raise ValueError(f"expected '(SECONDS.MICROS) IFACE ID#DATA', got {text[:60]!r}")
-    seconds, micros, iface, frame, direction = match.groups()
-    timestamp = int(seconds) + int(micros) * 1e-6
+        raise ValueError(f"expected '(SECONDS.MICROS) IFACE ID#DATA' (6 or 9 digits after the "
+                         f"point), got {text[:60]!r}")
+    seconds, fraction, iface, frame, direction = match.groups()
+    timestamp = int(seconds) + int(fraction) / 10 ** len(fraction)
     id_text, hash_, data_text = frame.partition("#")
     if not hash_:
         raise ValueError(f"bad frame {frame!r}: expected ID#DATA (no '#' found)")
@@ -97,7 +101,7 @@ def parse_dropcount(text):
     match = _DROPCOUNT_RE.match(text)
     if not match:
         raise ValueError(f"bad DROPCOUNT line {text[:80]!r}: expected \"DROPCOUNT: dropped N "
-                         f"CAN frames on 'IFACE' socket (total drops M)\"")
+                         f"CAN frames on 'ARG' socket (total drops M)\"")
     return int(match.group(1))
 
 
@@ -124,8 +128,10 @@ def read_log(path, on_dropped=None):
 
 
 class LogReplayBus(can.BusABC):
-    """A log as a bus: recv() returns its frames in order, then None. With `realtime`, each
-    frame waits until its time after the first, as it came on the bus."""
+    """A log as a bus: recv() returns its frames in order; at the end of the log it returns
+    None at once, whatever its timeout (None too: a log has nothing more to wait for), and sets
+    `ended`. `for message in bus:` ends there as well. With `realtime`, each frame waits until
+    its time after the first, as it came on the bus."""
 
     def __init__(self, path, node_id=None, realtime=False, **kwargs):
         super().__init__(channel=str(path), **kwargs)
@@ -141,6 +147,18 @@ class LogReplayBus(can.BusABC):
 
     def _count_dropped(self, frames):
         self.dropped += frames
+
+    def recv(self, timeout=None):
+        # python-can's recv asks _recv_internal again while the timeout lasts (forever with
+        # None), which at the end of a log would never return.
+        while True:
+            message, _ = self._recv_internal(timeout)
+            if message is None or self._matches_filters(message):
+                return message
+
+    def __iter__(self):
+        # python-can's __iter__ polls forever; a log ends.
+        return iter(self.recv, None)
 
     def _recv_internal(self, timeout):
         for message in self._frames:

@@ -1,7 +1,9 @@
-"""Follows one drive's frames without I/O: decodes them, assembles telemetry samples and keeps
-the latest frame of each message. The client feeds it from its receive thread; the command
-line feeds it from a log."""
+"""Follows one drive's frames without I/O: decodes them, assembles telemetry samples, keeps the
+latest frame of each message, checks the protocol its version frame names and counts its
+restarts (startup.py). The client feeds it from its receive thread; the command line feeds it
+from a log or a bus."""
 from . import frames as frames_
+from . import startup
 from .telemetry import TelemetryAssembler
 
 
@@ -11,6 +13,8 @@ class Monitor:
         self.assembler = TelemetryAssembler()
         self.latest = {}  # message name -> its latest frame object
         self.counts = {}  # message name -> frames decoded
+        self.protocol_error = None  # the first ProtocolMismatch a version frame showed
+        self._restarts = startup.RestartDetector()
 
     @property
     def node_id(self):
@@ -20,6 +24,11 @@ class Monitor:
     def skipped(self):
         return self.decoder.skipped
 
+    @property
+    def restarts(self):
+        """How many times the drive was seen to start again."""
+        return self._restarts.restarts
+
     def feed(self, message):
         """Takes a python-can Message; returns (frame object or None, TelemetrySample or None)."""
         frame = self.decoder.decode(message)
@@ -28,7 +37,14 @@ class Monitor:
         name = frame.MESSAGE.name
         self.latest[name] = frame
         self.counts[name] = self.counts.get(name, 0) + 1
+        if name == "version" and self.protocol_error is None:
+            self.protocol_error = startup.protocol_mismatch(frame)
+        self._restarts.feed(frame)
         return frame, self.assembler.feed(frame)
 
     def heartbeat(self):
         return self.latest.get("heartbeat")
+
+    def version(self):
+        """The latest Version frame, or None."""
+        return self.latest.get("version")
