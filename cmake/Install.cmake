@@ -10,10 +10,12 @@
 #                                          motors as ../motors/NAME.toml, as in the source tree)
 #   share/imdrive/tools                    the plot scripts drive_sim runs, with their modules
 #   share/imdrive/can/drive.dbc            the CAN protocol for DBC-aware tools
-#   share/doc/imdrive                      README.md and docs/
+#   share/doc/imdrive                      README.md, docs/ and tools/python/README.md: the
+#                                          source tree's layout, so their relative links resolve
 #   lib/python3/dist-packages/imdrive      the Python client (Debian's path: with prefix /usr,
 #                                          as the .deb installs, python3 finds it unaided);
-#   bin/imdrive                            its command line
+#   bin/imdrive                            its command line (finds ../lib/python3/dist-packages
+#                                          under any prefix)
 if(CMAKE_CROSSCOMPILING OR NOT CMAKE_SYSTEM_NAME STREQUAL "Linux")
   return()
 endif()
@@ -48,15 +50,16 @@ install(CODE "set(IMD_VERSION_HEADER \"${IMD_VERSION_DIR}/imd_version.hpp\")
 set(IMD_VERSION_TEXT \"${IMD_INSTALL_DATADIR}/tools/imd_version.txt\")")
 install(SCRIPT ${CMAKE_CURRENT_LIST_DIR}/InstallVersionText.cmake)
 install(FILES ${PROJECT_SOURCE_DIR}/docs/can/drive.dbc DESTINATION ${IMD_INSTALL_DATADIR}/can)
+# The README links docs/... and tools/python/README.md: the same layout under DOCDIR.
 install(FILES ${PROJECT_SOURCE_DIR}/README.md DESTINATION ${CMAKE_INSTALL_DOCDIR})
-install(DIRECTORY ${PROJECT_SOURCE_DIR}/docs/ DESTINATION ${CMAKE_INSTALL_DOCDIR})
+install(DIRECTORY ${PROJECT_SOURCE_DIR}/docs/ DESTINATION ${CMAKE_INSTALL_DOCDIR}/docs)
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/tools/python/imdrive DESTINATION ${IMD_INSTALL_PYTHONDIR}
         PATTERN "__pycache__" EXCLUDE PATTERN "*.pyc" EXCLUDE)
-# ...and its command line as `imdrive` (its #!/usr/bin/python3 finds the package there).
+# ...and its command line as `imdrive` (it puts ../lib/python3/dist-packages on the path).
 install(PROGRAMS ${PROJECT_SOURCE_DIR}/tools/python/imdrive_cli.py
         DESTINATION ${CMAKE_INSTALL_BINDIR} RENAME imdrive)
 install(FILES ${PROJECT_SOURCE_DIR}/tools/python/README.md
-        DESTINATION ${CMAKE_INSTALL_DOCDIR}/python)
+        DESTINATION ${CMAKE_INSTALL_DOCDIR}/tools/python)
 
 # The Debian package: Debian 12's own libraries, so the tools run from /usr/bin as they are.
 # The Python parts are recommended: the C++ tools run without them.
@@ -68,7 +71,8 @@ set(CPACK_PACKAGE_VERSION ${PROJECT_VERSION})
 set(CPACK_PACKAGE_CONTACT ${IMD_DEB_MAINTAINER})
 set(CPACK_PACKAGE_DESCRIPTION_SUMMARY
     "Induction-motor drive: simulator, CAN monitor and host tools")
-set(CPACK_PACKAGE_DESCRIPTION
+# One string: set() with several would join them with ';' into the package's text.
+string(CONCAT CPACK_PACKAGE_DESCRIPTION
     "The host side of the imdrive induction-motor drive firmware: drive_sim (the firmware on a "
     "simulated board), drive_monitor (watch and command a drive over SocketCAN), drive_hil (the "
     "drive in real time against a simulated motor), the DBC file of the CAN protocol, the "

@@ -33,8 +33,25 @@ struct CurrentFedCoefficients {
 /// valid parameters and T0_s > 0. Not for tick context.
 CurrentFedCoefficients discretize_current_fed(const MotorParameters& motor, double T0_s);
 
+/// The same in the control arithmetic T: double is the reference above, float the MCU's
+/// (control/float_discretization.cpp). In float each coefficient is within 12 u (u = 2^-24)
+/// of the value for the float-rounded parameters, times the conditioning of its last
+/// difference: (sigma + |expm1(-eta T0)|) / |sigma + expm1(-eta T0)| for flux_from_i_now_H
+/// (near 1 at the drive's periods), (eta + c/J) / (eta - c/J) for torque_to_speed; expf and
+/// expm1f are taken within 1 ulp. Not for tick context.
+template <typename T>
+CurrentFedCoefficients discretize_current_fed(const MotorParameters& motor, double T0_s);
+template <>
+inline CurrentFedCoefficients discretize_current_fed<double>(const MotorParameters& motor,
+                                                             double T0_s) {
+  return discretize_current_fed(motor, T0_s);
+}
+template <>
+CurrentFedCoefficients discretize_current_fed<float>(const MotorParameters& motor, double T0_s);
+
 /// (exp(x) - 1) / x, equal to 1 at x = 0, without cancellation for small |x|.
 double phi1(double x) noexcept;
+float phi1(float x) noexcept;
 
 /// One-step maps of the exact discrete model, in float or double. Tick context.
 template <typename T>

@@ -39,6 +39,43 @@ struct VoltageFedCoefficients {
 /// context: start-up and the service loop. Requires valid parameters and delta_s > 0.
 VoltageFedCoefficients discretize_voltage_fed(const MotorParameters& motor, double delta_s);
 
+/// The same coefficients computed in the control arithmetic T: T = double is the reference
+/// above; T = float is the MCU's, cheap enough to recompute outside the tick for a new rotor
+/// resistance (control/float_discretization.cpp), with the Metzler exponential of
+/// control/metzler_exponential.hpp. Its error, relative to each coefficient, is at most
+///   2^s 80 u + (2 theta_0 + 4) eta_in + 8 u,   u = 2^-24,
+/// 2^s 80 u the exponential's rounding (s its squarings, theta_0 its shifted generator's norm:
+/// metzler_squarings, metzler_shifted_norm); (2 theta_0 + 4) eta_in the generator's own
+/// rounding, eta_in relative on each entry: a Metzler exponential is monotone in its
+/// generator, so the entries move by at most eta_in (mu + mean walk length) <= eta_in (theta_0 +
+/// theta_0 + 4); 8 u the final products and the mechanical expm1f. eta_in = 9 u when float
+/// represents the parameters exactly (sigma Lr by a fused difference within 2 u, then at most
+/// seven operations, (alpha + gamma) delta the longest chain); parameters that float rounds add
+/// 3 u and twice sigma's conditioning Ls Lr / (Ls Lr - Lm^2) (tens for real motors) in u.
+/// docs/derivations.md derives it. Not for tick context.
+template <typename T>
+VoltageFedCoefficients discretize_voltage_fed(const MotorParameters& motor, double delta_s);
+template <>
+inline VoltageFedCoefficients discretize_voltage_fed<double>(const MotorParameters& motor,
+                                                             double delta_s) {
+  return discretize_voltage_fed(motor, delta_s);
+}
+template <>
+VoltageFedCoefficients discretize_voltage_fed<float>(const MotorParameters& motor, double delta_s);
+
+/// The generators the float discretization exponentiates, already times delta: the axis
+/// generator A3 delta, its additive compound times delta and the friction g = -f delta / J.
+struct VoltageFedFloatGenerators {
+  Eigen::Matrix3f axis = Eigen::Matrix3f::Zero();
+  Eigen::Matrix3f compound = Eigen::Matrix3f::Zero();
+  float friction = 0.0f;
+  float mu_per_kgm2 = 0.0f;     ///< mu of paper 000
+  float inv_J_per_kgm2 = 0.0f;  ///< 1 / J
+  float delta_s = 0.0f;         ///< sample period
+};
+VoltageFedFloatGenerators voltage_fed_float_generators(const MotorParameters& motor,
+                                                       double delta_s) noexcept;
+
 /// Generator of one axis of the rotor-frame dynamics (5) with the held input as a third state:
 /// d/dt (phi, i, v) = A3 (phi, i, v); A = A3 (x) I2 acts on both axes alike.
 Eigen::Matrix3d voltage_fed_axis_generator(const MotorParameters& motor);

@@ -342,7 +342,8 @@ inline void Drive<T>::publish(uint64_t k, const Measurement<T>& m, const Estimat
   }
   // The holding brake: released only while a law controls the motion (and the PWM is on).
   const bool release = supervisor_.brake_released() && hw_.pwm.enabled();
-  status.brake_engaged = !release;
+  // The heartbeat reports a brake only where one is fitted: no line, nothing holds the rotor.
+  status.brake_engaged = config_.brake_output_line >= 0 && !release;
   r.brake_engaged = !release;
   r.stop = status.stop;
   if (release != brake_line_level_) {

@@ -5,8 +5,9 @@
 /// motion model. It is built whole from one record, outside the tick (at construction, or by
 /// Drive::service after a parameter write), and the tick uses it only while it is complete.
 /// Building it costs the structured exponentials of the discretization and the laws' designs: far
-/// more than a tick, which is why it is never done in one. While the drive runs, a model on a
-/// new rotor resistance replaces it at a tick boundary and takes over its state
+/// more than a tick, which is why it is never done in one. The discretization runs in T, float on
+/// the MCU (control/float_discretization.cpp: about 8 000 instructions there). While the drive
+/// runs, a model on a new rotor resistance replaces it at a tick boundary and takes over its state
 /// (continue_from), so that the tracked Rr reaches every part (docs/robustness.md).
 #include "control/motor_parameters.hpp"
 #include "control/rotor_resistance_mras.hpp"
@@ -46,7 +47,7 @@ struct MotorModel {
   MotorModel(const control::MotorParameters& m, const DriveConfig& config,
              const BoardScales& board, double nominal_Rr_Ohm = 0.0)
       : motor(m),
-        coefficients(control::discretize_voltage_fed(m, config.sample_period_s)),
+        coefficients(control::discretize_voltage_fed<T>(m, config.sample_period_s)),
         observers(coefficients, m.pole_pairs, config.encoder_observer_bandwidth_rad_s),
         predictor(coefficients, config.pwm_latency_ticks, config.compensate_latency),
         laws(LawContext{m, config, coefficients}),

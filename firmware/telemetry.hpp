@@ -31,7 +31,8 @@ struct DriveStatus {
   bool can_bus_off = false;
   Limitation limited = Limitation::none;  ///< a limit holds the running drive back
   StopCategory stop = StopCategory::none;  ///< how the latched fault stops the drive
-  bool brake_engaged = true;               ///< the holding brake (engaged unless running)
+  /// The holding brake engaged: a brake line is configured and not driven (false without one).
+  bool brake_engaged = true;
   uint8_t reset_cause = 0;                 ///< why the board last started (hal::ResetCause)
   // The last commissioning run: its step (kIdentifyStepValues; 6 none yet), progress and end.
   uint8_t identify_step = 6;

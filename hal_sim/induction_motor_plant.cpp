@@ -7,6 +7,7 @@
 #include <numbers>
 
 #include "hal_sim/rk4.hpp"
+#include "hal_sim/rk6_integrator.hpp"
 
 namespace imd::sim {
 namespace {
@@ -98,25 +99,39 @@ StateVector InductionMotorPlant::voltage_fed_derivative(const StateVector& x, co
   return dx;
 }
 
-template <typename VoltageLaw>
+template <bool smooth, typename Rhs>
+StateVector InductionMotorPlant::integrate_period(const StateVector& x,
+                                                  const Rhs& rhs) const noexcept {
+  if (smooth && config_.integrator == PlantIntegrator::rk6 && brake_Nm_ == 0.0) {
+    // The speed at the period's start sets the step; within one period it changes by far less
+    // than the margin of the bound (plant_integrator.hpp).
+    const double rho_per_s =
+        k_.alpha_per_s + k_.gamma_per_s + motor_.pole_pairs * std::abs(x(4));
+    const int steps = rk6_steps(rho_per_s, config_.period_s);
+    return rk6_integrate(x, config_.period_s / steps, steps, rhs);
+  }
+  return integrate(x, config_.period_s / config_.rk4_substeps, config_.rk4_substeps, rhs);
+}
+
+template <bool smooth, typename VoltageLaw>
 void InductionMotorPlant::integrate_voltage_fed(const VoltageLaw& voltage_of_state,
                                                 double load_Nm) noexcept {
-  const double h = config_.period_s / config_.rk4_substeps;
   const auto rhs = [&](const StateVector& x) {
     return voltage_fed_derivative(x, voltage_of_state(x), load_Nm);
   };
-  state_ = unpack(integrate(pack(state_), h, config_.rk4_substeps, rhs));
+  state_ = unpack(integrate_period<smooth>(pack(state_), rhs));
   time_s_ += config_.period_s;
 }
 
 void InductionMotorPlant::step_voltage(const Vec2& u_s_alphabeta_V, double load_Nm) noexcept {
-  integrate_voltage_fed([&](const StateVector&) { return u_s_alphabeta_V; }, load_Nm);
+  integrate_voltage_fed<true>([&](const StateVector&) { return u_s_alphabeta_V; }, load_Nm);
 }
 
 void InductionMotorPlant::step_voltage(const Vec2& u_s_alphabeta_V,
                                        const CurrentDependentVoltage& error,
                                        double load_Nm) noexcept {
-  integrate_voltage_fed(
+  // The inverter's error switches with the current's sign: RK4 with its small steps.
+  integrate_voltage_fed<false>(
       [&](const StateVector& x) -> Vec2 {
         return u_s_alphabeta_V + error.error_V(constrained(x.segment<2>(2)));
       },
@@ -176,7 +191,7 @@ Vec2 InductionMotorPlant::analog_feedback_voltage_V(const Vec2& v_AB_V) const no
 }
 
 void InductionMotorPlant::step_analog_feedback(const Vec2& v_AB_V, double load_Nm) noexcept {
-  integrate_voltage_fed(
+  integrate_voltage_fed<true>(
       [&](const StateVector& x) -> Vec2 {
         return feedback_2(k_, motor_.pole_pairs, x.segment<2>(0), x.segment<2>(2), x(4), x(5),
                           v_AB_V);
@@ -213,8 +228,7 @@ void InductionMotorPlant::step_current_fed(const Vec2& i_s_AB_A, double load_Nm)
     dx(5) = x(4);
     return dx;
   };
-  const double h = config_.period_s / config_.rk4_substeps;
-  StateVector x = integrate(pack(state_), h, config_.rk4_substeps, rhs);
+  StateVector x = integrate_period<true>(pack(state_), rhs);
   x.segment<2>(2) = current_at(x(5));
   state_ = unpack(x);
   time_s_ += config_.period_s;

@@ -18,6 +18,7 @@
 
 #include "control/frames.hpp"
 #include "control/motor_parameters.hpp"
+#include "hal_sim/plant_integrator.hpp"
 
 namespace imd::sim {
 
@@ -55,6 +56,9 @@ struct VoltageSegment {
 struct PlantConfig {
   double period_s = 1e-4;  ///< one call of a step function advances this much
   int rk4_substeps = 10;   ///< RK4 steps per period
+  /// rk6: the sixth-order steps of plant_integrator.hpp where the right-hand side is smooth
+  /// (RK4 with rk4_substeps elsewhere).
+  PlantIntegrator integrator = PlantIntegrator::rk4;
 };
 
 class InductionMotorPlant {
@@ -139,8 +143,13 @@ class InductionMotorPlant {
                                      double load_Nm) const noexcept;
 
  private:
-  template <typename VoltageLaw>
+  /// `smooth`: the voltage law is smooth in the state, so the sixth-order method may run it.
+  template <bool smooth, typename VoltageLaw>
   void integrate_voltage_fed(const VoltageLaw& voltage_of_state, double load_Nm) noexcept;
+  /// The state after one period of dx/dt = rhs(x) from x: RK4 with rk4_substeps, or with
+  /// `smooth` and the rk6 integrator (no brake engaged) the sixth-order steps.
+  template <bool smooth, typename Rhs>
+  StateVector integrate_period(const StateVector& x, const Rhs& rhs) const noexcept;
   /// A stator current (or its derivative) under the open phases' constraint: as is with none
   /// open, without the open axis' component with one, zero with more.
   Vec2 constrained(const Vec2& current) const noexcept;

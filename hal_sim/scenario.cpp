@@ -118,6 +118,14 @@ control::MotorParameters parse_plant_table(const toml::table& doc, const KeyOrig
 
 Scenario load_scenario(const std::filesystem::path& path, const std::vector<std::string>& overrides,
                        const std::optional<std::filesystem::path>& model_file) {
+  std::vector<ScenarioOverride> flagged;
+  for (const std::string& o : overrides) flagged.push_back({o, "--set " + o});
+  return load_scenario_with_flags(path, flagged, model_file);
+}
+
+Scenario load_scenario_with_flags(const std::filesystem::path& path,
+                                  const std::vector<ScenarioOverride>& overrides,
+                                  const std::optional<std::filesystem::path>& model_file) {
   const detail::ScenarioDocument document = detail::assemble_scenario(path, overrides, model_file);
   const toml::table& doc = document.doc;
   const KeyOrigins& origins = document.origins;
@@ -142,8 +150,9 @@ Scenario load_scenario(const std::filesystem::path& path, const std::vector<std:
   s.iol_period_s = r.positive("drive.iol_period_s", 1e-3);
   const double ratio = s.iol_period_s / s.sample_period_s;
   if (std::abs(ratio - std::round(ratio)) > 1e-9 * ratio || ratio < 1.0) {
-    r.fail("drive.iol_period_s",
-           fmt::format("= {}: must be a whole number of drive.sample_period_s", s.iol_period_s));
+    r.fail_with("drive.iol_period_s", "drive.sample_period_s",
+                fmt::format("= {}: must be a whole number of drive.sample_period_s ({})",
+                            s.iol_period_s, s.sample_period_s));
   }
   s.outer_speed_loop = r.boolean("drive.outer_speed_loop", false);
   s.outer_flux_loop = r.boolean("drive.outer_flux_loop", false);
@@ -153,8 +162,9 @@ Scenario load_scenario(const std::filesystem::path& path, const std::vector<std:
   s.ifoc_current_bandwidth_rad_s = r.non_negative("drive.ifoc_current_bandwidth_rad_s", 0.0);
   s.ifoc_speed_bandwidth_rad_s = r.non_negative("drive.ifoc_speed_bandwidth_rad_s", 0.0);
   if (s.flux_loop_time_constant_s < 2.0 * s.iol_period_s) {  // keeps Kp below e (docs/iol.md)
-    r.fail("drive.flux_loop_time_constant_s",
-           fmt::format("= {}: must be >= 2 drive.iol_period_s", s.flux_loop_time_constant_s));
+    r.fail_with("drive.flux_loop_time_constant_s", "drive.iol_period_s",
+                fmt::format("= {}: must be >= 2 drive.iol_period_s ({})",
+                            s.flux_loop_time_constant_s, s.iol_period_s));
   }
   s.magnetized_fraction = r.number("drive.magnetized_fraction", 0.95);
   s.magnetizing_current_A = r.non_negative("drive.magnetizing_current_A", 0.0);
@@ -177,14 +187,20 @@ Scenario load_scenario(const std::filesystem::path& path, const std::vector<std:
   // follows a torque reference.
   // With command_source = "can" it comes only from CAN commands.
   if (r.present("nameplate") && s.command_source != "can") {
-    r.fail("drive.command_source",
-           "a commissioning run ([nameplate]) needs command_source = "
-           "\"can\": the nameplate and the identify command go over CAN");
+    const std::string why =
+        "a commissioning run ([nameplate]) needs drive.command_source = \"can\": the nameplate "
+        "and the identify command go over CAN";
+    // Named at the one the command line added, if one was: that is the user's latest step.
+    if (r.from_command_line("nameplate") && !r.from_command_line("drive.command_source")) {
+      r.fail_with("nameplate", "drive.command_source", why);
+    }
+    r.fail_with("drive.command_source", "nameplate", why);
   }
   if (s.command_source == "can") {
     if (r.present("reference.speed")) {
-      r.fail("reference.speed",
-             "must be absent with drive.command_source = \"can\" (CAN commands set the speed)");
+      r.fail_with("reference.speed", "drive.command_source",
+                  "must be absent with drive.command_source = \"can\" (CAN commands set the "
+                  "speed)");
     }
   } else if (!iol || s.outer_speed_loop || r.find("reference.speed.kind") != nullptr) {
     read_speed_reference(r, s);
@@ -212,20 +228,23 @@ Scenario load_scenario(const std::filesystem::path& path, const std::vector<std:
 
   s.v_bus_V = r.positive("inverter.v_bus_V", 311.0);
   if (s.v_bus_V >= s.adc.bus_full_scale_V) {
-    r.fail("inverter.v_bus_V",
-           fmt::format("= {}: must be below sensors.adc_bus_full_scale_V", s.v_bus_V));
+    r.fail_with("inverter.v_bus_V", "sensors.adc_bus_full_scale_V",
+                fmt::format("= {}: must be below sensors.adc_bus_full_scale_V ({})", s.v_bus_V,
+                            s.adc.bus_full_scale_V));
   }
   s.i_max_A = r.positive_or_inf("inverter.i_max_A");
   s.limit_voltage = r.boolean("inverter.limit_voltage", true);
   s.inverter.dead_time_s = r.non_negative("inverter.dead_time_s", 0.0);
   if (s.inverter.dead_time_s >= 0.1 * s.sample_period_s) {  // a 10 % duty loss is no inverter
-    r.fail("inverter.dead_time_s",
-           fmt::format("= {}: must be below 0.1 * drive.sample_period_s", s.inverter.dead_time_s));
+    r.fail_with("inverter.dead_time_s", "drive.sample_period_s",
+                fmt::format("= {}: must be below 0.1 * drive.sample_period_s ({})",
+                            s.inverter.dead_time_s, s.sample_period_s));
   }
   s.inverter.device_drop_V = r.non_negative("inverter.device_drop_V", 0.0);
   if (s.inverter.device_drop_V >= 0.1 * s.v_bus_V) {
-    r.fail("inverter.device_drop_V",
-           fmt::format("= {}: must be below 0.1 * inverter.v_bus_V", s.inverter.device_drop_V));
+    r.fail_with("inverter.device_drop_V", "inverter.v_bus_V",
+                fmt::format("= {}: must be below 0.1 * inverter.v_bus_V ({})",
+                            s.inverter.device_drop_V, s.v_bus_V));
   }
   s.switching_inverter =
       r.choice("inverter.model", "average", {"average", "switching"}) == "switching";
@@ -237,10 +256,10 @@ Scenario load_scenario(const std::filesystem::path& path, const std::vector<std:
   s.dsmc_speed_bandwidth_rad_s = r.number("drive.dsmc_speed_bandwidth_rad_s", 0.0);
   if (s.dsmc_speed_bandwidth_rad_s < 0.0 ||
       s.dsmc_speed_bandwidth_rad_s > 0.5 / s.sample_period_s) {
-    r.fail("drive.dsmc_speed_bandwidth_rad_s",
-           fmt::format("= {}: must be in [0, {}] rad/s (0: the rule; at most half the sample "
-                       "rate)",
-                       s.dsmc_speed_bandwidth_rad_s, 0.5 / s.sample_period_s));
+    r.fail_with("drive.dsmc_speed_bandwidth_rad_s", "drive.sample_period_s",
+                fmt::format("= {}: must be in [0, {}] rad/s (0: the rule; at most half the sample "
+                            "rate)",
+                            s.dsmc_speed_bandwidth_rad_s, 0.5 / s.sample_period_s));
   }
   s.rotor_resistance_tracking = r.boolean("drive.rotor_resistance_tracking", true);
   s.rr_convergence_time_constant_s = r.number("drive.rr_convergence_time_constant_s", 0.0);
@@ -256,8 +275,8 @@ Scenario load_scenario(const std::filesystem::path& path, const std::vector<std:
 
   s.section_iv = r.boolean("observers.section_iv", false);
   if (s.section_iv && !s.ideal_sensors) {
-    r.fail("observers.section_iv",
-           "needs sensors.ideal = true (the Section IV estimators take the measured speed)");
+    r.fail_with("observers.section_iv", "sensors.ideal",
+                "needs sensors.ideal = true (the Section IV estimators take the measured speed)");
   }
   s.encoder_bandwidth_rad_s = r.positive("observers.encoder_bandwidth_rad_s", 400.0);
   s.load_estimator_pole = r.number("observers.load_estimator_pole", 0.99);
@@ -277,6 +296,8 @@ Scenario load_scenario(const std::filesystem::path& path, const std::vector<std:
     if (*scale < 0.2 || *scale > 5.0) r.fail(key, fmt::format("= {}: must be in [0.2, 5]", *scale));
   }
   s.substeps = static_cast<int>(r.integer("simulation.substeps", 10, 1, 10000));
+  const std::span<const std::string_view> integrators(kPlantIntegratorNames);
+  s.integrator = *integrator_named(r.choice("simulation.integrator", "rk6", integrators));
   s.inner_feedback =
       r.choice("simulation.inner_feedback", "digital", {"digital", "ideal_analog"}) == "digital"
           ? InnerFeedback::digital
@@ -288,13 +309,15 @@ Scenario load_scenario(const std::filesystem::path& path, const std::vector<std:
   s.initial_theta_mech_rad = r.number("simulation.initial_theta_mech_rad", 0.0);
   s.current_fed = r.boolean("simulation.current_fed", false);
   if (s.current_fed && (!iol || !s.ideal_sensors)) {
-    r.fail("simulation.current_fed", "needs drive.controller = \"iol\" and sensors.ideal = true");
+    r.fail_with("simulation.current_fed", iol ? "sensors.ideal" : "drive.controller",
+                "needs drive.controller = \"iol\" and sensors.ideal = true");
   }
 
   s.settle_s = r.non_negative("metrics.settle_s", 0.5);
   if (s.settle_s >= s.duration_s) {
-    r.fail("metrics.settle_s",
-           fmt::format("= {}: must be below simulation.duration_s", s.settle_s));
+    r.fail_with(
+        "metrics.settle_s", "simulation.duration_s",
+        fmt::format("= {}: must be below simulation.duration_s ({})", s.settle_s, s.duration_s));
   }
 
   detail::read_can(r, s);

@@ -144,7 +144,10 @@ struct Scenario {
 
   // [simulation]
   double duration_s = 1.0;
-  int substeps = 10;
+  int substeps = 10;  ///< RK4 steps per period (rk4, and where rk6 falls back to RK4)
+  /// The sixth-order steps where the plant is smooth (hal_sim/plant_integrator.hpp): as
+  /// accurate as RK4 at 10 us (tests/hal_sim/test_plant_integrator.cpp), several times faster.
+  PlantIntegrator integrator = PlantIntegrator::rk6;
   InnerFeedback inner_feedback = InnerFeedback::digital;
   int pwm_latency_ticks = 1;
   uint64_t seed = 1;
@@ -174,5 +177,17 @@ struct Scenario {
 Scenario load_scenario(const std::filesystem::path& path,
                        const std::vector<std::string>& overrides = {},
                        const std::optional<std::filesystem::path>& model_file = std::nullopt);
+
+/// An override and the command-line text that gave it, which messages name as its key's origin:
+/// {"simulation.duration_s=0.3", "--duration-s 0.3"}. load_scenario's are "--set ASSIGNMENT".
+struct ScenarioOverride {
+  std::string assignment;  ///< table.key=VALUE
+  std::string flag;        ///< as the user wrote it
+};
+
+/// load_scenario for a tool whose options besides --set change keys (drive_sim --duration-s).
+Scenario load_scenario_with_flags(const std::filesystem::path& path,
+                                  const std::vector<ScenarioOverride>& overrides,
+                                  const std::optional<std::filesystem::path>& model_file);
 
 }  // namespace imd::sim

@@ -30,8 +30,9 @@ void read_commissioning(Reader& r, Scenario& s) {
   c.rotate = r.boolean("identify.rotate", true);
   c.start_s = r.positive("identify.start_s", 0.1);
   if (c.start_s + 0.005 >= s.duration_s) {
-    r.fail("identify.start_s",
-           fmt::format("= {}: must leave time before simulation.duration_s", c.start_s));
+    r.fail_with("identify.start_s", "simulation.duration_s",
+                fmt::format("= {}: must leave time before simulation.duration_s ({})", c.start_s,
+                            s.duration_s));
   }
   // The nameplate writes 1 ms apart (each is served outside the tick before the next), then
   // the command.

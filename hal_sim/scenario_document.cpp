@@ -23,9 +23,11 @@ toml::table parse_override_value(const std::string& text) {
   }
 }
 
-/// Applies one --set table.key=VALUE; its keys' origin becomes that flag.
-void apply_override(ScenarioDocument& d, const std::string& assignment) {
-  const std::string flag = "--set " + assignment;
+/// Applies one table.key=VALUE; its keys' origin becomes the flag that gave it, and so does
+/// that of each table it creates (a --set nameplate.pole_pairs=2 adds [nameplate]).
+void apply_override(ScenarioDocument& d, const ScenarioOverride& override_) {
+  const std::string& assignment = override_.assignment;
+  const std::string& flag = override_.flag;
   const auto equals = assignment.find('=');
   if (equals == std::string::npos || equals == 0) {
     throw ConfigError(fmt::format("{}: expected table.key=VALUE", flag));
@@ -42,11 +44,14 @@ void apply_override(ScenarioDocument& d, const std::string& assignment) {
     throw ConfigError(fmt::format("{}: unknown key {}", flag, path));
   }
   toml::table* table = &d.doc;
+  std::string table_path;
   for (std::size_t i = 0; i + 1 < parts.size(); ++i) {
+    table_path += (i == 0 ? "" : ".") + parts[i];
     toml::node* child = table->get(parts[i]);
     if (child == nullptr) {
       table->insert(parts[i], toml::table{});
       child = table->get(parts[i]);
+      d.origins.set(table_path, flag);
     }
     table = child->as_table();
     if (table == nullptr) throw ConfigError(fmt::format("{}: {} is not a table", flag, parts[i]));
@@ -57,12 +62,25 @@ void apply_override(ScenarioDocument& d, const std::string& assignment) {
   d.origins.set(path, flag);
 }
 
-/// The path of the motor file `file` names (relative to the scenario's directory).
+/// The path of the motor file `file` names: relative to the scenario's directory, also when a
+/// --set gives it (docs/scenarios.md), which the message says when there is no such file.
 std::filesystem::path motor_path_of(const std::filesystem::path& scenario, const toml::node& file,
                                     const std::string& key, const std::string& origin) {
   const auto* name = file.as_string();
   if (name == nullptr) throw ConfigError(fmt::format("{}: {} must be a string", origin, key));
-  return scenario.parent_path() / name->get();
+  const std::filesystem::path path = scenario.parent_path() / name->get();
+  std::error_code status;
+  if (!std::filesystem::exists(path, status)) {
+    const std::filesystem::path directory = scenario.parent_path();
+    if (std::filesystem::path(name->get()).is_absolute()) {
+      throw ConfigError(fmt::format("{}: {}: {}: cannot open file", origin, key, path.string()));
+    }
+    throw ConfigError(fmt::format(
+        "{}: {}: {}: cannot open file (\"{}\" is taken relative to the scenario's directory, "
+        "{})",
+        origin, key, path.string(), name->get(), directory.empty() ? "." : directory.string()));
+  }
+  return path;
 }
 
 /// The [motor] table of the motor file at `motor_path`.
@@ -92,7 +110,7 @@ void inherit_plant_origins(ScenarioDocument& d, const toml::table& base,
 }  // namespace
 
 ScenarioDocument assemble_scenario(const std::filesystem::path& path,
-                                   const std::vector<std::string>& overrides,
+                                   const std::vector<ScenarioOverride>& overrides,
                                    const std::optional<std::filesystem::path>& model_file) {
   const std::string source = path.string();
   ScenarioDocument d{parse_toml_file(path), KeyOrigins(source), std::nullopt};
@@ -117,13 +135,20 @@ ScenarioDocument assemble_scenario(const std::filesystem::path& path,
   const KeyOrigins scenario_origins = d.origins;
   if (model_file) {
     if (doc.get("motor") != nullptr) scenario_motor = *doc.get("motor")->as_table();
+    std::error_code status;
+    if (!std::filesystem::exists(*model_file, status)) {
+      throw ConfigError(
+          fmt::format("{}: cannot open file (a relative path is taken from the "
+                      "working directory, {})",
+                      model_file->string(), std::filesystem::current_path(status).string()));
+    }
     const toml::table model_doc = parse_toml_file(*model_file);
     (void)parse_motor_table(model_doc, model_file->string());  // its own errors, its own name
     doc.insert_or_assign("motor", *model_doc.get("motor")->as_table());
     d.origins.clear_below("motor");
     d.origins.set("motor", model_file->string());
   }
-  for (const std::string& assignment : overrides) apply_override(d, assignment);
+  for (const ScenarioOverride& override_ : overrides) apply_override(d, override_);
   // [plant] motor_file: the simulated motor starts from that file instead of [motor].
   d.plant_base = scenario_motor;
   toml::table* plant = doc["plant"].as_table();

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "hal_sim/scenario.hpp"
 #include "hal_sim/scenario_origins.hpp"
 
 namespace imd::sim::detail {
@@ -30,9 +31,9 @@ struct ScenarioDocument {
 /// Reads the scenario file at `path`, inlines `motor_file` and `plant.motor_file` (relative to
 /// the scenario's directory), puts `model_file`'s [motor] in place of the scenario's (the
 /// plant keeps the scenario's) and applies the `overrides` (table.key=VALUE) in order. Throws
-/// ConfigError naming the file or the --set at fault.
+/// ConfigError naming the file or the flag at fault.
 ScenarioDocument assemble_scenario(const std::filesystem::path& path,
-                                   const std::vector<std::string>& overrides,
+                                   const std::vector<ScenarioOverride>& overrides,
                                    const std::optional<std::filesystem::path>& model_file);
 
 }  // namespace imd::sim::detail

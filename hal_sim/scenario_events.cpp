@@ -79,9 +79,9 @@ FaultInjection read_fault(Reader& r, const std::string& base, const toml::table&
       // The kind says which way the bus moves from inverter.v_bus_V.
       const bool over = fault.kind == FaultKind::overvoltage;
       if (over ? !(fault.bus_V > nominal_bus_V) : !(fault.bus_V < nominal_bus_V)) {
-        r.fail(key("bus_V"),
-               fmt::format("= {}: must be {} inverter.v_bus_V ({} V) for {}", fault.bus_V,
-                           over ? "above" : "below", nominal_bus_V, kind_name));
+        r.fail_with(key("bus_V"), "inverter.v_bus_V",
+                    fmt::format("= {}: must be {} inverter.v_bus_V ({} V) for {}", fault.bus_V,
+                                over ? "above" : "below", nominal_bus_V, kind_name));
       }
       break;
     }
@@ -190,8 +190,22 @@ void read_protection(Reader& r, Scenario& s) {
   p.bus_min_V = r.optional_positive("protection.bus_min_V");
   p.bus_max_V = r.optional_positive("protection.bus_max_V");
   if (p.bus_min_V && p.bus_max_V && !(*p.bus_max_V > *p.bus_min_V)) {
-    r.fail("protection.bus_max_V", fmt::format("= {}: must be above protection.bus_min_V ({})",
-                                               *p.bus_max_V, *p.bus_min_V));
+    r.fail_with(
+        "protection.bus_max_V", "protection.bus_min_V",
+        fmt::format("= {}: must be above protection.bus_min_V ({})", *p.bus_max_V, *p.bus_min_V));
+  }
+  // A limit on the wrong side of the nominal bus trips the drive as soon as it runs.
+  if (p.bus_max_V && !(*p.bus_max_V > s.v_bus_V)) {
+    r.fail_with("protection.bus_max_V", "inverter.v_bus_V",
+                fmt::format("= {}: must be above inverter.v_bus_V ({} V), or the drive trips at "
+                            "once",
+                            *p.bus_max_V, s.v_bus_V));
+  }
+  if (p.bus_min_V && !(*p.bus_min_V < s.v_bus_V)) {
+    r.fail_with("protection.bus_min_V", "inverter.v_bus_V",
+                fmt::format("= {}: must be below inverter.v_bus_V ({} V), or the drive trips at "
+                            "once",
+                            *p.bus_min_V, s.v_bus_V));
   }
   p.overspeed_rad_s = r.optional_positive("protection.overspeed_rad_s");
   p.encoder_missing_counts = r.optional_positive("protection.encoder_missing_counts");

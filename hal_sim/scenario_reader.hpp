@@ -37,6 +37,26 @@ class Reader {
   [[noreturn]] void fail(std::string_view path, const std::string& what) const {
     throw ConfigError(fmt::format("{}: {}: {}", origins_.of(path), path, what));
   }
+  /// Fails at `path` for a rule it shares with `other`. When `other`'s value came from another
+  /// place (another file, a command-line flag), the message names that place too and how to
+  /// change either: "FILE: metrics.settle_s: = 0.5: must be below simulation.duration_s (0.3);
+  /// simulation.duration_s comes from --duration-s 0.3: change it there, or --set
+  /// metrics.settle_s=VALUE".
+  [[noreturn]] void fail_with(std::string_view path, std::string_view other,
+                              const std::string& what) const {
+    const std::string& here = origins_.of(path);
+    const std::string& there = origins_.of(other);
+    if (here == there) fail(path, what);
+    if (from_command_line(path)) {
+      fail(path, fmt::format("{}; {} comes from {}", what, other, there));
+    }
+    fail(path, fmt::format("{}; {} comes from {}: change it there, or --set {}=VALUE", what, other,
+                           there, path));
+  }
+  /// Whether the key's value came from a command-line flag (--set, --duration-s), not a file.
+  bool from_command_line(std::string_view path) const {
+    return origins_.of(path).rfind("--", 0) == 0;
+  }
 
   /// Whether the document has the key (without marking it read).
   bool present(std::string_view path) const { return doc_.at_path(path).node() != nullptr; }
@@ -69,14 +89,16 @@ class Reader {
     if (!(value > 0.0)) fail(path, fmt::format("= {}: must be > 0", value));
     return value;
   }
-  /// A positive number, or inf for "no limit".
+  /// A positive number, or inf for "no limit" (also when the key is absent).
   double positive_or_inf(std::string_view path) {
+    constexpr double kInf = std::numeric_limits<double>::infinity();
     const toml::node* node = find(path);
-    if (node != nullptr && node->is_floating_point() &&
-        node->as_floating_point()->get() == std::numeric_limits<double>::infinity()) {
-      return std::numeric_limits<double>::infinity();
+    if (node == nullptr) return kInf;
+    const std::optional<double> value = node->is_number() ? node->value<double>() : std::nullopt;
+    if (!value || !(*value > 0.0) || std::isnan(*value)) {
+      fail(path, fmt::format("= {}: must be a number > 0, or inf for no limit", text(*node)));
     }
-    return positive(path, std::numeric_limits<double>::infinity());
+    return *value;
   }
   double non_negative(std::string_view path, std::optional<double> fallback) {
     const double value = number(path, fallback);
@@ -208,7 +230,7 @@ class Reader {
 void read_faults(Reader& r, Scenario& s);        ///< [[faults]] (after inverter.v_bus_V)
 void read_can_commands(Reader& r, Scenario& s);  ///< [[can_commands]]
 void read_can(Reader& r, Scenario& s);           ///< [can]
-void read_protection(Reader& r, Scenario& s);    ///< [protection]
+void read_protection(Reader& r, Scenario& s);    ///< [protection] (after inverter.v_bus_V)
 /// [nameplate], [identify]: appends the nameplate writes and the identify command to
 /// s.can_commands.
 void read_commissioning(Reader& r, Scenario& s);

@@ -30,7 +30,7 @@ class InverterError final : public CurrentDependentVoltage {
 
 SimBoard::SimBoard(const control::MotorParameters& motor, const SimBoardConfig& config)
     : config_(config),
-      plant_(motor, {config.period_s, config.substeps}),
+      plant_(motor, {config.period_s, config.substeps, config.integrator}),
       Rs0_Ohm_(motor.Rs_Ohm),
       Rr0_Ohm_(motor.Rr_Ohm),
       adc_model_(config.adc, config.seed),

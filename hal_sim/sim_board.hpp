@@ -54,6 +54,8 @@ struct HoldingBrake {
 struct SimBoardConfig {
   double period_s = 1e-4;
   int substeps = 10;          ///< RK4 steps per period
+  /// How the plant integrates a period (plant_integrator.hpp); RK4 with `substeps` by default.
+  PlantIntegrator integrator = PlantIntegrator::rk4;
   int pwm_latency_ticks = 1;  ///< 0 or 1
   InnerFeedback inner_feedback = InnerFeedback::digital;
   bool current_source = false;  ///< the ideal current source drives the motor

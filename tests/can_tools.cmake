@@ -9,6 +9,9 @@ imd_add_test(test_drive_monitor_parameters unit LIBRARIES imd_drive_monitor
              SOURCES tools/test_drive_monitor_parameters.cpp)
 imd_add_test(test_drive_monitor_capture unit LIBRARIES imd_drive_monitor
              SOURCES tools/test_drive_monitor_capture.cpp)
+# send set-speed --enable against a drive on the simulated board.
+imd_add_test(test_drive_monitor_enable sim LIBRARIES imd_drive_monitor imd_hal_sim
+             SOURCES tools/test_drive_monitor_enable.cpp)
 # drive_sim --can-log's two directions, on a short run of the CAN scenario.
 imd_add_test(test_can_log_host_frames sim LIBRARIES imd_can_log imd_sim_drive
              SOURCES tools/test_can_log_host_frames.cpp)
@@ -96,6 +99,20 @@ if(TARGET drive_monitor)
                    parameters --can vcan9 --node 1)
   imd_monitor_test(drive_monitor_send_bad_counter 2 "--counter: Value 16 not in range 0 to 15"
                    send --can vcan9 --node 1 --counter 16 enable)
+  # A CSV that cannot be created is bad input, found before the log is read: exit 2, as the
+  # help says.
+  imd_monitor_test(drive_monitor_csv_not_creatable 2
+                   "drive_monitor: /nonexistent/t.csv: cannot open file for writing"
+                   watch --log ${CAN_DATA}/monitor_sample.log --csv /nonexistent/t.csv)
+  imd_monitor_test(drive_monitor_watch_help_exit_codes 0
+                   "2 bad input \\(command line, interface, a CSV that cannot be created"
+                   watch --help)
+  # send --enable: only with set-speed, and only repeated (the watchdog needs the repeats).
+  imd_monitor_test(drive_monitor_send_enable_needs_repeat 2 "--enable requires --repeat-hz"
+                   send --can vcan9 --node 1 set-speed 30 --enable)
+  imd_monitor_test(drive_monitor_send_enable_with_set_speed_only 2
+                   "drive_monitor: --enable goes with set-speed only .*, not set-flux"
+                   send --can vcan9 --node 1 set-flux 0.2 --repeat-hz 10 --for-s 1 --enable)
 endif()
 
 # libFuzzer harnesses (clang only): the fuzz preset turns them on.

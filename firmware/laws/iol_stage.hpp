@@ -41,7 +41,7 @@ template <typename T>
 class IolStage {
  public:
   IolStage(const control::MotorParameters& motor, const DriveConfig& config)
-      : coefficients_(control::discretize_current_fed(motor, config.iol_period_s)),
+      : coefficients_(control::discretize_current_fed<T>(motor, config.iol_period_s)),
         law_(coefficients_, control::IolConfig{}),
         flux_loop_(coefficients_.flux_decay,
                    control::place_flux_outer_loop(coefficients_.flux_decay, config.iol_period_s,

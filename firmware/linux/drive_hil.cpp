@@ -1,7 +1,8 @@
 // drive_hil: the drive firmware on Linux in real time, against the simulated motor, commanded
-// and watched over SocketCAN like a board.
+// and watched over SocketCAN like a board (or, without SocketCAN, over TCP as a socketcand
+// server: --can socketcand:[HOST:]PORT).
 //
-//   drive_hil SCENARIO.toml --can IFACE --node N
+//   drive_hil SCENARIO.toml --can IFACE|socketcand:[HOST:]PORT --node N
 //             [--gpio-chip NAME [--enable-line L] [--fault-line L] [--timing-line L]
 //              [--enable-active-low]]
 //             [--parameters PATH] [--duration-s S] [--latency-report PATH] [--priority P]
@@ -44,8 +45,7 @@
 #include "firmware/parameters/motor_record.hpp"
 #include "hal/linux/file_parameter_store.hpp"
 #include "hal/linux/gpiod_lines.hpp"
-#include "hal/linux/can_bit_rate.hpp"
-#include "hal/linux/queued_can_bus.hpp"
+#include "firmware/linux/hil_can.hpp"
 #include "hal/linux/realtime_timer.hpp"
 #include "hal_sim/config_error.hpp"
 #include "hal_sim/drive/simulated_drive.hpp"
@@ -124,7 +124,7 @@ std::string wait_for_stop(const sigset_t& signals, std::optional<double> duratio
 }
 
 template <typename T>
-int run(const Options& o, const imd::sim::Scenario& s, imd::hal::QueuedCanBus* can,
+int run(const Options& o, const imd::sim::Scenario& s, imd::firmware::HilCan* can,
         imd::hal::GpiodLines* gpio, const Lines& lines, const sigset_t& signals,
         std::vector<std::string> warnings) {
   using namespace imd;
@@ -162,16 +162,17 @@ int run(const Options& o, const imd::sim::Scenario& s, imd::hal::QueuedCanBus* c
                          "starts unconfigured");
     }
   }
-  sim::SimulatedDrive<T> simulated(board, s.motor, config,
-                                   {s.ideal_sensors, s.inner_feedback, s.current_fed},
-                                   &references, timer, can, gpio,
-                                   file_store ? &*file_store : nullptr);
+  sim::SimulatedDrive<T> simulated(
+      board, s.motor, config, {s.ideal_sensors, s.inner_feedback, s.current_fed}, &references,
+      timer, can != nullptr ? can->bus() : nullptr, gpio, file_store ? &*file_store : nullptr);
   firmware::Drive<T>& drive = simulated.drive();
   firmware::HilTick<T> tick(board, drive, s.faults);
 
   std::cerr << fmt::format("drive_hil: {} on {} as node {}, {} Hz, {} precision{}\n", s.source,
-                           can != nullptr ? fmt::format("{} at {}", can->iface(), bit_rate_text())
-                                          : "no CAN bus",
+                           can == nullptr ? "no CAN bus"
+                           : can->socketcand_address().empty()
+                               ? fmt::format("{} at {}", can->name(), bit_rate_text())
+                               : "socketcand " + can->socketcand_address(),
                            o.node,
                            std::lround(1.0 / s.sample_period_s), s.precision,
                            gpio != nullptr ? fmt::format(", GPIO {} ({} lines)", gpio->chip_name(),
@@ -209,8 +210,8 @@ int run(const Options& o, const imd::sim::Scenario& s, imd::hal::QueuedCanBus* c
   facts.precision = s.precision;
   facts.drive_overruns = drive.execution().overruns;
   facts.telemetry_dropped = drive.telemetry().dropped_frames();
-  facts.can_iface = can != nullptr ? can->iface() : "none";
-  if (can != nullptr) facts.can = can->counters();
+  facts.can_iface = "none";
+  if (can != nullptr) can->report(facts);
   std::cout << firmware::report_text(facts) << std::flush;
 
   int status = reason == "plant diverged" ? kExitFailed : 0;
@@ -235,7 +236,10 @@ int main(int argc, char** argv) {
   app.add_option("scenario", o.scenario, "Scenario file (TOML)")->required();
   app.add_option("--can", o.can,
                  fmt::format("SocketCAN interface, e.g. can0 (configured for the protocol's {}, "
-                             "else refused) or vcan0; 'none': no bus",
+                             "else refused) or vcan0; socketcand:[HOST:]PORT: serve the bus over "
+                             "TCP in the socketcand protocol, for a machine without SocketCAN "
+                             "(host 127.0.0.1 unless given; port 0: any free one); 'none': no "
+                             "bus",
                              bit_rate_text()))
       ->required();
   app.add_option("--node", o.node, "CAN node id")
@@ -302,16 +306,21 @@ int main(int argc, char** argv) {
   pthread_sigmask(SIG_BLOCK, &signals, nullptr);
 
   std::string error;
-  std::unique_ptr<imd::hal::QueuedCanBus> can;
+  std::unique_ptr<imd::firmware::HilCan> can;
   if (with_can) {
-    // This node's message ids only: the block of 32 ids at node * 32.
-    const imd::hal::CanIdFilter node_ids{static_cast<uint16_t>(o.node * 32), 0x7E0};
-    can = imd::hal::QueuedCanBus::open(o.can, error, {node_ids});
+    const std::optional<imd::firmware::HilCanSpec> spec =
+        imd::firmware::parse_hil_can(o.can, error);
+    if (!spec) return fail(error);
+    // One write per line: the I/O thread's lines never interleave with the main thread's.
+    auto log = [](const std::string& text) {
+      std::cerr << "drive_hil: socketcand: " + text + "\n";
+    };
+    can = imd::firmware::HilCan::open(*spec, o.node, kBitRate_bit_s, error, log);
     if (!can) return fail(error);
-    // A CAN controller at another bit rate would disturb the whole bus: refused before the
-    // drive sends anything.
-    const std::string mismatch = imd::hal::bit_rate_mismatch(o.can, kBitRate_bit_s);
-    if (!mismatch.empty()) return fail(mismatch);
+    if (spec->socketcand) {
+      log(fmt::format("listening on {} (raw mode), e.g. imdrive watch --socketcand {}",
+                      can->socketcand_address(), can->socketcand_address()));
+    }
   }
   const Lines lines = board_lines(o);
   std::unique_ptr<imd::hal::GpiodLines> gpio;

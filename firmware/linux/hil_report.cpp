@@ -60,6 +60,13 @@ nlohmann::json report_json(const HilRunFacts& f) {
     j["can"]["bus_off_events"] = f.can->bus_off_events;
     j["can"]["last_error"] = hal::describe_error_class(f.can->last_error_class);
   }
+  if (f.socketcand) {
+    j["can"]["socketcand"] = {{"clients", f.socketcand->clients},
+                              {"clients_refused", f.socketcand->clients_refused},
+                              {"dropped_no_client", f.socketcand->dropped_no_client},
+                              {"client_errors", f.socketcand->client_errors},
+                              {"filtered", f.socketcand->filtered}};
+  }
   return j;
 }
 
@@ -87,6 +94,13 @@ std::string report_text(const HilRunFacts& f) {
         f.can_iface, f.can->sent, f.can->received, f.can->rx_dropped, f.can->error_frames,
         hal::describe_error_class(f.can->last_error_class), f.can->bus_off_events,
         f.telemetry_dropped);
+  }
+  if (f.socketcand) {
+    text += fmt::format(
+        "drive_hil: socketcand: {} clients ({} refused busy), {} frames dropped with no client, "
+        "{} client messages answered with an error\n",
+        f.socketcand->clients, f.socketcand->clients_refused, f.socketcand->dropped_no_client,
+        f.socketcand->client_errors);
   }
   return text;
 }

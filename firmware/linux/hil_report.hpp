@@ -11,6 +11,7 @@
 
 #include "hal/linux/latency_histogram.hpp"
 #include "hal/linux/queued_can_bus.hpp"
+#include "hal/linux/socketcand_server.hpp"
 
 namespace imd::firmware {
 
@@ -29,8 +30,9 @@ struct HilRunFacts {
   std::string state, first_fault, precision;
   uint64_t drive_overruns = 0;
   uint32_t telemetry_dropped = 0;
-  std::string can_iface;  ///< "none" without a bus
+  std::string can_iface;  ///< "none" without a bus, "socketcand:127.0.0.1:29536" over TCP
   std::optional<hal::QueuedCanCounters> can;
+  std::optional<hal::SocketcandCounters> socketcand;  ///< with --can socketcand:...
 };
 
 /// Percentiles of a histogram in us: p50, p99, p99.9, max, mean, and the samples of at least

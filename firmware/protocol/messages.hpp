@@ -133,7 +133,7 @@ inline constexpr Signal kHeartbeatOwnSignals[] = {
     {"stop", 4, 2, false, 1, 1, 0.0f, "",
      "the stop category of the latched fault (firmware/protection/stop_category.hpp)",
      kStopValues},
-    {"brake", 47, 1, false, 1, 1, 0.0f, "", "the holding brake is engaged (its line not driven)"},
+    {"brake", 47, 1, false, 1, 1, 0.0f, "", "engaged: a brake line is configured and not driven"},
     {"reset_cause", 6, 2, false, 1, 1, 0.0f, "", "why the board last started (hal/watchdog.hpp)",
      kResetCauseValues},
 };

@@ -12,6 +12,7 @@ SimBoardConfig board_config(const Scenario& s) {
   SimBoardConfig c;
   c.period_s = s.sample_period_s;
   c.substeps = s.substeps;
+  c.integrator = s.integrator;
   c.pwm_latency_ticks = s.pwm_latency_ticks;
   c.inner_feedback = s.inner_feedback;
   c.current_source = s.current_fed;

@@ -82,7 +82,7 @@ TEST(Scenario, BadInputNamesTheKey) {
        "reference.flux.flux2_Wb2: = 0.0005: must be > 0.002 Wb^2"},
       {{"sensors.ideal=false", "observers.section_iv=true"},
        "observers.section_iv: needs sensors.ideal = true"},
-      {{"inverter.i_max_A=-inf"}, "inverter.i_max_A: = -inf: must be finite"},
+      {{"inverter.i_max_A=-inf"}, "inverter.i_max_A: = -inf: must be a number > 0, or inf"},
       {{"drive.command_source=can"},
        "reference.speed: must be absent with drive.command_source = \"can\""},
       {{"drive.command_source=serial"},

@@ -1,8 +1,10 @@
 // Where a scenario's errors point: the file that holds the key (the scenario, a motor file it
-// names, the --motor-file) or the --set override that set it; and every integer key refuses a
-// fraction, naming the key.
+// names, the --motor-file) or the flag that set it (--set, --duration-s), and for a rule
+// between two keys where the other came from; and every integer key refuses a fraction, naming
+// the key.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -188,6 +190,113 @@ TEST_F(ScenarioFiles, IntegerKeysOfEventsRefuseAFraction) {
     const std::string path = scenario("good.toml", c.body);
     EXPECT_TRUE(starts_with(error_of(path), path + ": " + c.message)) << error_of(path);
   }
+}
+
+std::string error_of_flags(const std::string& path,
+                           const std::vector<ScenarioOverride>& overrides) {
+  try {
+    load_scenario_with_flags(path, overrides, std::nullopt);
+  } catch (const ConfigError& error) {
+    return error.what();
+  }
+  return "(no error)";
+}
+
+TEST(ScenarioErrors, ACrossKeyCheckNamesWhereEachValueCameFrom) {
+  // The duration from --duration-s (or a --set) is named, with the way out, though the
+  // failing key is the file's.
+  EXPECT_EQ(error_of_flags(kPaper, {{"simulation.duration_s=0.005", "--duration-s 0.005"}}),
+            kPaper +
+                ": metrics.settle_s: = 0.01: must be below simulation.duration_s (0.005); "
+                "simulation.duration_s comes from --duration-s 0.005: change it there, or --set "
+                "metrics.settle_s=VALUE");
+  EXPECT_EQ(error_of(kPaper, {"simulation.duration_s=0.005"}),
+            kPaper +
+                ": metrics.settle_s: = 0.01: must be below simulation.duration_s (0.005); "
+                "simulation.duration_s comes from --set simulation.duration_s=0.005: change it "
+                "there, or --set metrics.settle_s=VALUE");
+  // The other way round: the flag's key fails, the file holds the other one.
+  EXPECT_EQ(error_of(kPaper, {"metrics.settle_s=9"}),
+            "--set metrics.settle_s=9: metrics.settle_s: = 9: must be below simulation.duration_s "
+            "(8); simulation.duration_s comes from " +
+                kPaper);
+  // Both from one place: the short message.
+  EXPECT_EQ(error_of(kPaper, {"simulation.duration_s=0.005", "metrics.settle_s=0.01"}),
+            "--set metrics.settle_s=0.01: metrics.settle_s: = 0.01: must be below "
+            "simulation.duration_s (0.005); simulation.duration_s comes from --set "
+            "simulation.duration_s=0.005");
+  EXPECT_EQ(error_of(kPaper, {"inverter.v_bus_V=600"}),
+            "--set inverter.v_bus_V=600: inverter.v_bus_V: = 600: must be below "
+            "sensors.adc_bus_full_scale_V (500); sensors.adc_bus_full_scale_V comes from " +
+                kPaper);
+}
+
+TEST_F(ScenarioFiles, ACrossKeyCheckWithinOneFileNamesOnlyIt) {
+  motor("good.toml", "Rs_Ohm", "Rs_Ohm = 14.0");
+  const std::string path = scenario("good.toml", "[simulation]\nduration_s = 0.2\n");
+  EXPECT_EQ(error_of(path),
+            path + ": metrics.settle_s: = 0.5: must be below simulation.duration_s (0.2)");
+}
+
+TEST(ScenarioErrors, TablesAnOverrideAddsAreTheOverrides) {
+  // [nameplate] from a --set on a scenario that is no commissioning run.
+  EXPECT_TRUE(starts_with(error_of(kPaper, {"nameplate.pole_pairs=2"}),
+                          "--set nameplate.pole_pairs=2: nameplate: a commissioning run "
+                          "([nameplate]) needs drive.command_source = \"can\""))
+      << error_of(kPaper, {"nameplate.pole_pairs=2"});
+  EXPECT_NE(error_of(kPaper, {"nameplate.pole_pairs=2"})
+                .find("drive.command_source comes from " + kPaper),
+            std::string::npos);
+  // The file's [nameplate] with a --set command source: the --set is named.
+  EXPECT_TRUE(starts_with(error_of(kIdentify, {"drive.command_source=profile"}),
+                          "--set drive.command_source=profile: drive.command_source: a "
+                          "commissioning run"))
+      << error_of(kIdentify, {"drive.command_source=profile"});
+  // faults made a table by a --set: its error is the --set's.
+  EXPECT_EQ(error_of(kPaper, {"faults.kind=overcurrent"}),
+            "--set faults.kind=overcurrent: faults: must be an array of tables ([[faults]])");
+}
+
+TEST(ScenarioErrors, ALimitWithoutALimitSaysInfIsAccepted) {
+  for (const char* value : {"infinity", "-inf", "0", "\"none\""}) {
+    const std::string message = error_of(kPaper, {std::string("drive.max_accel_rad_s2=") + value});
+    EXPECT_NE(message.find(": must be a number > 0, or inf for no limit"), std::string::npos)
+        << message;
+  }
+  EXPECT_TRUE(std::isinf(load_scenario(kPaper, {"drive.max_accel_rad_s2=inf"}).max_accel_rad_s2));
+  EXPECT_EQ(load_scenario(kPaper, {"inverter.i_max_A=30"}).i_max_A, 30.0);
+}
+
+TEST(ScenarioErrors, BusLimitsMustLieAroundTheNominalBus) {
+  EXPECT_EQ(error_of(kPaper, {"protection.bus_max_V=100"}),
+            "--set protection.bus_max_V=100: protection.bus_max_V: = 100: must be above "
+            "inverter.v_bus_V (311 V), or the drive trips at once; inverter.v_bus_V comes from " +
+                kPaper);
+  EXPECT_EQ(error_of(kPaper, {"protection.bus_min_V=311"}),
+            "--set protection.bus_min_V=311: protection.bus_min_V: = 311: must be below "
+            "inverter.v_bus_V (311 V), or the drive trips at once; inverter.v_bus_V comes from " +
+                kPaper);
+  EXPECT_EQ(error_of(kPaper, {"inverter.v_bus_V=200", "protection.bus_min_V=250"}),
+            "--set protection.bus_min_V=250: protection.bus_min_V: = 250: must be below "
+            "inverter.v_bus_V (200 V), or the drive trips at once; inverter.v_bus_V comes from "
+            "--set inverter.v_bus_V=200");
+  const Scenario s =
+      load_scenario(kPaper, {"protection.bus_min_V=250", "protection.bus_max_V=400"});
+  EXPECT_EQ(s.protection.bus_max_V, 400.0);
+}
+
+TEST(ScenarioErrors, AMissingMotorFileSaysWhatItIsRelativeTo) {
+  const std::string directory = std::filesystem::path(kPaper).parent_path().string();
+  EXPECT_EQ(error_of(kPaper, {"plant.motor_file=nosuch.toml"}),
+            "--set plant.motor_file=nosuch.toml: plant.motor_file: " + directory +
+                "/nosuch.toml: cannot open file (\"nosuch.toml\" is taken relative to the "
+                "scenario's directory, " +
+                directory + ")");
+  const std::string model = error_of(kPaper, {}, std::filesystem::path("nosuch_model.toml"));
+  EXPECT_EQ(model,
+            "nosuch_model.toml: cannot open file (a relative path is taken from the "
+            "working directory, " +
+                std::filesystem::current_path().string() + ")");
 }
 
 TEST(ScenarioErrors, WholeNumbersStillLoad) {

@@ -1,8 +1,10 @@
 #!/bin/sh
 # check_deb.sh BUILD_DIR WORK_DIR: makes the Debian package of the build tree with cpack,
 # extracts it with dpkg-deb -x into a scratch root, and runs the installed tools from there:
-# every tool's --version (the build's), a short scenario of the installed data with a plot, and
-# a check that drive_sim runs the installed plot script, not the source tree's.
+# every tool's --version (the build's), the package's description, the installed README's and
+# docs' relative links, the Python command line under a prefix other than /usr, a short
+# scenario of the installed data with a plot, and a check that drive_sim runs the installed
+# plot script, not the source tree's.
 set -eu
 build=$1
 work=$2
@@ -17,6 +19,10 @@ set -- "$work"/package/imdrive_*.deb
 [ -f "$1" ] || fail "no imdrive_*.deb in $work/package"
 deb=$1
 dpkg-deb --field "$deb" Package Version Depends Recommends
+description=$(dpkg-deb --field "$deb" Description)
+case $description in
+  *";"*) fail "the package's description has a ';' (a CMake list joined): $description" ;;
+esac
 dpkg-deb -x "$deb" "$work/root"
 root=$work/root/usr
 
@@ -35,15 +41,21 @@ for script in plot_seed000.py plot_seed001.py; do
   [ "$version" = "$header" ] || fail "$script --version: $version, the build's header has $header"
 done
 for file in share/imdrive/can/drive.dbc share/imdrive/motors/seed000.toml \
-            share/doc/imdrive/README.md share/doc/imdrive/flashing.md \
+            share/doc/imdrive/README.md share/doc/imdrive/docs/flashing.md \
+            share/doc/imdrive/tools/python/README.md \
             lib/python3/dist-packages/imdrive/__init__.py; do
   [ -s "$root/$file" ] || fail "usr/$file is not installed"
 done
 
-# The Python client's command line, from the package's dist-packages (as /usr puts it on the path).
+# The installed README and docs keep the source tree's layout: every relative link resolves.
+/usr/bin/python3 "$(dirname "$0")/../docs/check_doc_links.py" "$root/share/doc/imdrive" \
+  > "$work/doc_links.log" || { cat "$work/doc_links.log"; fail "broken links in usr/share/doc/imdrive"; }
+
+# The Python client's command line, run as installed: the scratch root is a prefix other than
+# /usr, so it must find ../lib/python3/dist-packages itself.
 [ -x "$root/bin/imdrive" ] || fail "imdrive is not installed in usr/bin"
-PYTHONPATH="$root/lib/python3/dist-packages" /usr/bin/python3 "$root/bin/imdrive" --version ||
-  fail "imdrive --version failed"
+version=$(env -u PYTHONPATH "$root/bin/imdrive" --version) || fail "imdrive --version failed"
+[ "$version" = "$header" ] || fail "imdrive --version: $version, the build's header has $header"
 
 # A short run of an installed scenario (its motor is ../motors/seed000.toml), with a plot.
 "$root/bin/drive_sim" "$root/share/imdrive/scenarios/seed000_realistic.toml" --duration-s 0.6 \

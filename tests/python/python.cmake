@@ -24,8 +24,10 @@ function(imd_pytest NAME LABEL MARKER)
                    --drive-sim=$<TARGET_FILE:drive_sim> --e2e-vectors=$<TARGET_FILE:e2e_vectors>
                    --source-dir=${PROJECT_SOURCE_DIR} --basetemp=${IMD_PY_WORK}/${NAME}
                    ${IMD_PY_TESTS})
+  # IMD_DRIVE_HIL: the real-time main, served over socketcand (test_socketcand_hil.py).
+  set(environment PYTHONDONTWRITEBYTECODE=1 MPLBACKEND=Agg IMD_DRIVE_HIL=$<TARGET_FILE:drive_hil>)
   set_tests_properties(${NAME} PROPERTIES LABELS ${LABEL} TIMEOUT 300
-                       ENVIRONMENT "PYTHONDONTWRITEBYTECODE=1;MPLBACKEND=Agg")
+                       ENVIRONMENT "${environment}")
 endfunction()
 imd_pytest(python_client_unit unit "not sim")
 imd_pytest(python_client_sim sim sim)

@@ -81,7 +81,7 @@ def test_watch_of_a_silent_node_warns_and_exits_4(source_dir, capsys):
 @pytest.mark.parametrize("args, message", [
     (["send", "--can", "vcan0", "--node", "64", "enable"], "--node: must be a node id in 0..63"),
     (["send", "--can", "vcan0", "launch"], "argument WORD: invalid choice: 'launch'"),
-    (["watch"], "one of the arguments --can --interface --log is required"),
+    (["watch"], "one of the arguments --can --socketcand --interface --log is required"),
     (["watch", "--log", "/nonexistent.log"], "/nonexistent.log: cannot open file"),
     (["plot", "--log", "x.log", "--duration-s", "-1"], "--duration-s: must be a time"),
     (["send", "--interface", "virtual", "enable"], "--interface virtual needs --channel"),

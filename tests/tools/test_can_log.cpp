@@ -10,6 +10,7 @@
 #include <optional>
 #include <ostream>
 #include <string>
+#include <utility>
 
 #include "tools/can_log/candump_log.hpp"
 
@@ -61,6 +62,24 @@ TEST(can_log_parser, RoundTripsEveryLengthAndTime) {
       EXPECT_EQ(back->data, f.data) << text;
       EXPECT_EQ(format_log_line(r.line->time_s, r.line->iface, r.line->frame), text);
     }
+  }
+}
+
+TEST(can_log_parser, ReadsNanosecondTimestampsRoundedToTheMicrosecond) {
+  // candump -N writes 9 digits; time_us rounds them half up, carrying into the seconds.
+  const std::pair<const char*, int64_t> cases[] = {
+      {"(1700000000.000250000) can0 022#01", 1'700'000'000'000'250},
+      {"(0.000000499) can0 022#01", 0},
+      {"(0.000000500) can0 022#01", 1},
+      {"(12.345678901) can0 022#01", 12'345'679},
+      {"(0.999999500) can0 022#01", 1'000'000},
+      {"(999999999999.999999999) can0 022#01", 1'000'000'000'000'000'000},
+  };
+  for (const auto& [text, time_us] : cases) {
+    const ParseResult r = parse_log_line(text);
+    ASSERT_TRUE(r.ok()) << text << ": " << r.error.message;
+    EXPECT_EQ(r.line->time_us, time_us) << text;
+    EXPECT_EQ(r.line->frame.id, 0x022) << text;
   }
 }
 
@@ -119,10 +138,12 @@ INSTANTIATE_TEST_SUITE_P(
         Malformed{"0.000100 can0 022#01", K::bad_timestamp, "bad timestamp '0.000100'"},
         Malformed{"(0.000100 can0 022#01", K::bad_timestamp, "expected '(SECONDS.MICROS)'"},
         Malformed{"(0.0001) can0 022#01", K::bad_timestamp, "'(0.0001)': expected"},
-        Malformed{"(1) can0 022#01", K::bad_timestamp, "with 6 decimals"},
+        Malformed{"(1) can0 022#01", K::bad_timestamp, "with 6 or 9 decimals"},
+        Malformed{"(0.0001000) can0 022#01", K::bad_timestamp, "with 6 or 9 decimals"},
+        Malformed{"(0.0000001000) can0 022#01", K::bad_timestamp, "'(0.0000001000)'"},
         Malformed{"(-1.000000) can0 022#01", K::bad_timestamp, "'(-1.000000)'"},
         Malformed{"(.000100) can0 022#01", K::bad_timestamp, "'(.000100)'"},
-        Malformed{"(1234567890123.000000) can0 022#01", K::bad_timestamp, "6 decimals"},
+        Malformed{"(1234567890123.000000) can0 022#01", K::bad_timestamp, "6 or 9 decimals"},
         Malformed{"(0.000100)can0 022#01", K::bad_separator, "one space after the timestamp"},
         Malformed{"(0.000100)            vcan0 022#01", K::bad_separator,
                   "12 spaces before interface 'vcan0': candump pads names to at most 15"},
@@ -230,7 +251,7 @@ TEST(can_log_reader, ReportsPathAndLineOfABadLine) {
   EXPECT_TRUE(reader.next(line));
   EXPECT_FALSE(reader.next(line));
   EXPECT_EQ(reader.error(),
-            path + ":4: bad timestamp '(0.3)': expected '(SECONDS.MICROS)' with 6 decimals");
+            path + ":4: bad timestamp '(0.3)': expected '(SECONDS.MICROS)' with 6 or 9 decimals");
   EXPECT_FALSE(reader.next(line));  // stays stopped
   std::remove(path.c_str());
 }

@@ -150,6 +150,17 @@ TEST(can_log_kinds, DropcountLines) {
   EXPECT_EQ(
       parse_dropcount_line("DROPCOUNT: dropped 1 CAN frame on 'vcan10' socket (total drops 1)"),
       1u);
+  // Debian 12's can-utils (2020.11.0) writes candump's argument, filters included, and a
+  // name longer than an interface's 15 characters is still the argument.
+  EXPECT_EQ(parse_dropcount_line(
+                "DROPCOUNT: dropped 2 CAN frames on 'can0,020:7E0,7FF:7FF' socket (total drops 2)"),
+            2u);
+  EXPECT_EQ(parse_dropcount_line(
+                "DROPCOUNT: dropped 2 CAN frames on 'averyverylongname0' socket (total drops 9)"),
+            2u);
+  EXPECT_EQ(parse_dropcount_line("DROPCOUNT: dropped 4 CAN frames on 'any,#FFFFFFFF,j' socket "
+                                 "(total drops 4)"),
+            4u);
   const char* malformed[] = {
       "DROPCOUNT: dropped 1 CAN frames on 'can0' socket (total drops 1)",  // plural for 1
       "DROPCOUNT: dropped 2 CAN frame on 'can0' socket (total drops 2)",   // singular for 2
@@ -159,7 +170,8 @@ TEST(can_log_kinds, DropcountLines) {
       "DROPCOUNT: dropped 2 CAN frames on 'can0' socket (total drops 2) ",
       "DROPCOUNT: dropped 2 CAN frames on 'can0' socket (total drops )",
       "DROPCOUNT: dropped 12345678901 CAN frames on 'can0' socket (total drops 2)",
-      "DROPCOUNT: dropped 2 CAN frames on 'averyverylongname0' socket (total drops 2)",
+      "DROPCOUNT: dropped 2 CAN frames on 'can0' socket (total drops 2)x",
+      "DROPCOUNT: dropped 2 CAN frames on 'can0 socket (total drops 2)",
       "DROPCOUNT:",
   };
   for (const char* text : malformed) EXPECT_FALSE(parse_dropcount_line(text)) << text;

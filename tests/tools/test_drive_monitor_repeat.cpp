@@ -315,5 +315,80 @@ TEST(drive_monitor_repeat, CountersComeBackIntoTheDrivesWindowAfterTooManyLostFr
             "(1 repeated_counter, 12 stale_counter), 3 unanswered");
 }
 
+// --- send set-speed --enable: the enable leads, the speed follows at once
+
+const protocol::Command kEnable{CommandKind::enable};
+
+TEST(drive_monitor_repeat, AnEnableLeadsAndTheSpeedFollowsAtOnceWithTheNextCounter) {
+  CommandRepeater repeater(kNode, kSpeed30, 5, {10.0, 0.2, 0.5}, kStart, kEnable);
+  EXPECT_EQ(repeater.next_event(), kStart);
+  const auto enable = repeater.frame_due(kStart);
+  ASSERT_TRUE(enable);
+  EXPECT_EQ(enable->id, protocol::can_id(kNode, MessageId::enable));
+  EXPECT_EQ(counter_of(*enable), 5);
+  repeater.sent(kStart, true);
+  const auto speed = repeater.frame_due(kStart);  // no wait for the enable's ack
+  ASSERT_TRUE(speed);
+  EXPECT_EQ(speed->id, protocol::can_id(kNode, MessageId::set_speed));
+  EXPECT_EQ(counter_of(*speed), 6);
+  repeater.sent(kStart, true);
+  repeater.receive(kStart + 1ms, ack_of(*enable, CommandResult::accepted));
+  repeater.receive(kStart + 1ms, ack_of(*speed, CommandResult::accepted));
+  const auto second = repeater.frame_due(kStart + 100ms);
+  ASSERT_TRUE(second);
+  EXPECT_EQ(counter_of(*second), 7);
+  repeater.sent(kStart + 100ms, true);
+  EXPECT_FALSE(repeater.finished(kStart + 100ms));
+  repeater.receive(kStart + 101ms, ack_of(*second, CommandResult::accepted));
+  EXPECT_TRUE(repeater.finished(kStart + 101ms));
+  EXPECT_EQ(verdict(repeater.tally()), RepeatVerdict::all_accepted);
+  EXPECT_EQ(repeat_summary(repeater.tally(), kSpeed30, 10.0),
+            "enable: accepted; sent 2 set_speed 30.000 rad/s frames at 10 Hz: 2 accepted, 0 "
+            "rejected, 0 unanswered");
+}
+
+TEST(drive_monitor_repeat, ARefusedEnableStopsTheRepetition) {
+  CommandRepeater repeater(kNode, kSpeed30, 0, {10.0, 60.0, 0.5}, kStart, kEnable);
+  const auto enable = repeater.frame_due(kStart);
+  repeater.sent(kStart, true);
+  const auto speed = repeater.frame_due(kStart);
+  repeater.sent(kStart, true);
+  repeater.receive(kStart + 2ms, ack_of(*enable, CommandResult::not_allowed));  // faulted
+  repeater.receive(kStart + 2ms, ack_of(*speed, CommandResult::accepted));
+  EXPECT_FALSE(repeater.frame_due(kStart + 100ms));
+  EXPECT_TRUE(repeater.finished(kStart + 2ms));
+  EXPECT_EQ(verdict(repeater.tally()), RepeatVerdict::rejected);
+  EXPECT_EQ(repeat_summary(repeater.tally(), kSpeed30, 10.0),
+            "enable: not_allowed; sent 1 set_speed 30.000 rad/s frames at 10 Hz: 1 accepted, 0 "
+            "rejected, 0 unanswered; stopped after 0.002 s");
+  // The socket refused the enable: nothing follows it.
+  CommandRepeater refused(kNode, kSpeed30, 0, {10.0, 60.0, 0.5}, kStart, kEnable);
+  ASSERT_TRUE(refused.frame_due(kStart));
+  refused.sent(kStart, false);
+  EXPECT_FALSE(refused.frame_due(kStart));
+  EXPECT_TRUE(refused.finished(kStart));
+  EXPECT_EQ(verdict(refused.tally()), RepeatVerdict::not_all_accepted);
+  // An enable without an ack: the speed goes on (the drive may have obeyed), the exit is not 0.
+  CommandRepeater silent(kNode, kSpeed30, 0, {10.0, 0.1, 0.5}, kStart, kEnable);
+  ASSERT_TRUE(silent.frame_due(kStart));
+  silent.sent(kStart, true);
+  const auto only = silent.frame_due(kStart);
+  silent.sent(kStart, true);
+  silent.receive(kStart + 1ms, ack_of(*only, CommandResult::accepted));
+  EXPECT_TRUE(silent.finished(kStart + 500ms));
+  EXPECT_EQ(verdict(silent.tally()), RepeatVerdict::not_all_accepted);
+  EXPECT_TRUE(silent.tally().lead->unanswered);
+}
+
+TEST(drive_monitor_repeat, TheDrivesDecoderAcceptsTheEnableAndEverySpeedFrame) {
+  SimulatedBus bus;
+  CommandRepeater repeater(kNode, kSpeed30, 4, {20.0, 1.0, 0.5}, kStart, kEnable);
+  bus.run(repeater);
+  ASSERT_EQ(bus.results.size(), 21u);  // the enable, then 20 speed frames
+  for (const CommandResult r : bus.results) EXPECT_EQ(r, CommandResult::accepted);
+  EXPECT_EQ(verdict(repeater.tally()), RepeatVerdict::all_accepted)
+      << repeat_summary(repeater.tally(), kSpeed30, 20.0);
+}
+
 }  // namespace
 }  // namespace imd::monitor

@@ -7,6 +7,7 @@
 #include "control/voltage_fed_model.hpp"
 #include "control/current_fed_model.hpp"
 #include "control/iol.hpp"
+#include "tools/bench/bench_main.hpp"
 
 namespace {
 
@@ -84,4 +85,4 @@ BENCHMARK_TEMPLATE(BM_DeadbeatCurrentStep, float)->Name("BM_DeadbeatCurrentStep/
 
 }  // namespace
 
-BENCHMARK_MAIN();
+int main(int argc, char** argv) { return imd::bench::run_benchmarks(argc, argv); }

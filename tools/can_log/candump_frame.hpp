@@ -48,7 +48,7 @@ inline constexpr uint32_t kErrorFlag = 0x20000000;
 /// What is wrong with a line (one kind per check, so that tests and tools can tell them apart).
 enum class ParseErrorKind : uint8_t {
   empty_line,
-  bad_timestamp,     ///< not "(SECONDS.MICROS)" with 6 decimals
+  bad_timestamp,     ///< not "(SECONDS.MICROS)" with 6 decimals (or 9, candump -N)
   bad_separator,     ///< fields not separated as candump separates them
   missing_field,     ///< the line ends before the interface or the frame
   bad_interface,     ///< empty, too long, or containing control characters

@@ -8,6 +8,7 @@ namespace {
 
 constexpr std::size_t kMaxSecondsDigits = 12;  // up to ~31700 years: no overflow in microseconds
 constexpr std::size_t kMicrosDigits = 6;
+constexpr std::size_t kNanosDigits = 9;          // candump -N
 constexpr std::size_t kMaxInterfaceLength = 15;  // IFNAMSIZ - 1: also candump's widest padding
 
 bool all_digits(std::string_view text) noexcept {
@@ -29,15 +30,19 @@ ParseResult fail(ParseErrorKind kind, std::string message) {
   return result;
 }
 
-/// "(SECONDS.MICROS)" -> microseconds, or -1.
+/// "(SECONDS.MICROS)" or "(SECONDS.NANOS)" -> microseconds (nanoseconds rounded half up), or -1.
 int64_t parse_timestamp(std::string_view inner) noexcept {
   const std::size_t dot = inner.find('.');
   if (dot == std::string_view::npos) return -1;
   const std::string_view seconds = inner.substr(0, dot);
-  const std::string_view micros = inner.substr(dot + 1);
+  const std::string_view fraction = inner.substr(dot + 1);
   if (!all_digits(seconds) || seconds.size() > kMaxSecondsDigits) return -1;
-  if (!all_digits(micros) || micros.size() != kMicrosDigits) return -1;
-  return decimal_value(seconds) * 1'000'000 + decimal_value(micros);
+  if (!all_digits(fraction)) return -1;
+  const int64_t whole_us = decimal_value(seconds) * 1'000'000;
+  if (fraction.size() == kMicrosDigits) return whole_us + decimal_value(fraction);
+  // Rounded in integers, so 0.999999500 carries into the next second exactly.
+  if (fraction.size() == kNanosDigits) return whole_us + (decimal_value(fraction) + 500) / 1000;
+  return -1;
 }
 
 /// The first character of `text` that is a control character, space or non-ASCII, or npos.
@@ -77,14 +82,13 @@ std::optional<uint64_t> parse_dropcount_line(std::string_view text) {
   if (!dropped || !consume(text, *dropped > 1 ? " CAN frames on '" : " CAN frame on '")) {
     return std::nullopt;
   }
-  const std::size_t quote_end = text.find('\'');
-  const std::string_view iface = text.substr(0, quote_end);
-  if (iface.empty() || iface.size() > kMaxInterfaceLength ||
-      first_bad_name_char(iface) != std::string_view::npos) {
-    return std::nullopt;
-  }
-  text.remove_prefix(iface.size());
-  if (!consume(text, "' socket (total drops ") || !consume_count(text) || text != ")") {
+  // '%s' is candump's argument as given, filters included ("can0,020:7E0,7FF:7FF"), so it is
+  // neither bounded to an interface name's length nor free of ',' ':': take it all.
+  constexpr std::string_view kSocketTail = "' socket (total drops ";
+  const std::size_t tail = text.rfind(kSocketTail);
+  if (tail == std::string_view::npos || tail == 0) return std::nullopt;
+  text.remove_prefix(tail);
+  if (!consume(text, kSocketTail) || !consume_count(text) || text != ")") {
     return std::nullopt;
   }
   return dropped;
@@ -102,8 +106,9 @@ ParseResult parse_log_line(std::string_view text) {
   ParsedLine line;
   line.time_us = parse_timestamp(text.substr(1, close - 1));
   if (line.time_us < 0) {
-    return fail(ParseErrorKind::bad_timestamp, "bad timestamp " + quote(text.substr(0, close + 1)) +
-                                                   ": expected '(SECONDS.MICROS)' with 6 decimals");
+    return fail(ParseErrorKind::bad_timestamp,
+                "bad timestamp " + quote(text.substr(0, close + 1)) +
+                    ": expected '(SECONDS.MICROS)' with 6 or 9 decimals");
   }
   line.time_s = double(line.time_us) * 1e-6;
 

@@ -5,6 +5,8 @@
 ///     (0.000100) can0 022#0103000000000000
 ///     (1700000000.000250) can0 18FF0001#0102 R
 ///
+/// The fraction has 6 digits, or 9 with candump -N (nanoseconds: rounded half up to the
+/// microsecond, so ParsedLine::time_us stays exact for 6 digits and within 0.5 us for 9).
 /// FRAME is any frame candump writes (candump_frame.hpp: classic, remote, 29-bit, CAN FD, error
 /// frames). DIRECTION, written by candump -x, is T for a frame the capturing host transmitted
 /// and R for one it received. With several interfaces candump right-aligns the names, so spaces
@@ -54,9 +56,10 @@ std::string format_log_line(double time_s, std::string_view iface, const LogFram
 std::string format_log_line(double time_s, std::string_view iface, const hal::CanFrame& frame,
                             Direction direction = Direction::unmarked);
 
-/// The frames a "DROPCOUNT: dropped N CAN frame(s) on 'IFACE' socket (total drops M)" line
+/// The frames a "DROPCOUNT: dropped N CAN frame(s) on 'ARG' socket (total drops M)" line
 /// says were lost (candump -d writes it where the socket dropped frames), or nullopt when the
-/// line is not exactly that.
+/// line is not exactly that. ARG is candump's argument as given, filters included
+/// ("can0,020:7E0,7FF:7FF"): any non-empty text up to the last "' socket (total drops ".
 std::optional<uint64_t> parse_dropcount_line(std::string_view text);
 
 /// Reads a log file line by line. Blank lines are skipped and a trailing '\r' is ignored;

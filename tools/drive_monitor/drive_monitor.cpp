@@ -4,7 +4,7 @@
 //   drive_monitor watch (--can IFACE | --log FILE) [--node N] [--csv PATH] [--table | --no-table]
 //                       [--duration-s S]
 //   drive_monitor send --can IFACE --node N COMMAND [VALUE] [--counter C] [--wait-heartbeat-s S]
-//                      [--wait-ack-s S] [--repeat-hz F --for-s S]
+//                      [--wait-ack-s S] [--repeat-hz F --for-s S [--enable]]
 //   drive_monitor parameters --can IFACE --node N [--set KEY=VALUE]... [--motor-file PATH]
 //                            [--save] [--motor-out PATH] [--wait-s S] [--wait-heartbeat-s S]
 //   drive_monitor identify --can IFACE --node N [--rotate] [--motor-out PATH] [--timeout-s S]
@@ -18,12 +18,16 @@
 // every 1/F s for S s, each frame with the next alive counter, and so keeps an enabled drive's
 // command watchdog fed (it needs a frame every command_timeout_s, 0.2 s by default). Acks are
 // matched as they come, --wait-ack-s per frame; SIGINT or SIGTERM ends the repetition early.
-// It prints one summary line: frames sent, accepted, rejected by reason, unanswered. The
+// It prints one summary line: frames sent, accepted, rejected by reason, unanswered. With
+// --enable (set-speed only) an enable frame goes first and the speed frames follow at once, so
+// one command starts the drive and feeds its watchdog; a refused enable stops the repetition. The
 // emergency stop may be repeated too: the tool never stands in the way of a stop, and the
 // drive obeys every estop frame whatever its counter, so repeats are harmless redundancy.
 //
-// Exit codes: 0 success (with --repeat-hz: every frame sent and accepted), 1 the CSV could not
-// be written, 2 bad input (command line, interface, log file), 3 a command frame rejected,
+// Exit codes: 0 success (with --repeat-hz: every frame sent and accepted), 1 an output file
+// could not be written once the work had begun (a write error on the CSV, --motor-out), 2 bad
+// input (command line, interface, log file, a CSV that cannot be created), 3 a command frame
+// rejected,
 // 4 no heartbeat or no acknowledgement (with --repeat-hz: none rejected, but some frame not
 // sent or unanswered); for watch, no frame at all from node N (in the log, or on the bus
 // before the end of --duration-s or an interrupt).
@@ -89,6 +93,7 @@ struct SendOptions {
   double wait_heartbeat_s = 0.5;
   double wait_ack_s = 0.5;
   std::optional<imd::monitor::RepeatPlan> repeat;  ///< --repeat-hz/--for-s; nullopt: send once
+  bool enable = false;                             ///< --enable: an enable frame first
 };
 
 /// send --repeat-hz: the frames go out on CommandRepeater's schedule; between them the loop
@@ -107,8 +112,11 @@ int send_repeated(imd::hal::SocketCanBus& bus, const SendOptions& o,
                  "default "
               << seconds_text(default_timeout_s) << " s\n";
   }
+  const auto lead = o.enable ? std::optional(imd::firmware::protocol::Command{
+                                   imd::firmware::protocol::CommandKind::enable})
+                             : std::nullopt;
   imd::monitor::CommandRepeater repeater(static_cast<uint8_t>(o.node), command, counter, plan,
-                                         Clock::now());
+                                         Clock::now(), lead);
   std::string bus_error;
   imd::hal::CanFrame frame;
   for (;;) {
@@ -141,6 +149,10 @@ int send(const SendOptions& o) {
   std::string error;
   const auto command = imd::monitor::parse_command(o.command, o.value, error);
   if (!command) return fail(error);
+  if (o.enable && command->kind != protocol::CommandKind::set_speed) {
+    return fail("--enable goes with set-speed only (it starts the drive at that speed), not " +
+                o.command);
+  }
   const auto bus = imd::hal::SocketCanBus::open(o.can, error);
   if (!bus) return fail(error);
   const auto node = static_cast<uint8_t>(o.node);
@@ -222,6 +234,11 @@ int main(int argc, char** argv) {
           ->check(kSeconds);
   repeat_option->needs(for_option);
   for_option->needs(repeat_option);
+  send_cmd
+      ->add_flag("--enable", s.enable,
+                 "With set-speed: send enable first, then the speed at once and repeated, so one "
+                 "command starts the drive and keeps its watchdog fed")
+      ->needs(repeat_option);
 
   ParametersOptions p;
   CLI::App* parameters = add_parameters_command(app, p);

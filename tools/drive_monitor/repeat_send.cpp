@@ -37,7 +37,12 @@ uint64_t RepeatTally::rejected_total() const {
 }
 
 RepeatVerdict verdict(const RepeatTally& tally) {
+  const auto& lead = tally.lead;
+  if (lead && lead->result && *lead->result != CommandResult::accepted) {
+    return RepeatVerdict::rejected;
+  }
   if (tally.rejected_total() > 0) return RepeatVerdict::rejected;
+  if (lead && lead->result != CommandResult::accepted) return RepeatVerdict::not_all_accepted;
   if (tally.sent > 0 && tally.send_failures == 0 && tally.accepted == tally.sent) {
     return RepeatVerdict::all_accepted;
   }
@@ -47,6 +52,14 @@ RepeatVerdict verdict(const RepeatTally& tally) {
 std::string repeat_summary(const RepeatTally& tally, const firmware::protocol::Command& command,
                            double rate_Hz) {
   std::ostringstream out;
+  if (const auto& lead = tally.lead) {
+    out << describe_command(lead->command) << ": "
+        << (lead->result       ? result_name(*lead->result)
+            : lead->unanswered ? std::string("unanswered")
+            : lead->sent       ? std::string("no ack yet")
+                               : std::string("not sent (transmit queue full or interface down)"))
+        << "; ";
+  }
   out << "sent " << tally.sent << ' ' << describe_command(command) << " frames at " << rate_Hz
       << " Hz: " << tally.accepted << " accepted, " << tally.rejected_total() << " rejected";
   if (tally.rejected_total() > 0) {
@@ -71,7 +84,8 @@ std::string repeat_summary(const RepeatTally& tally, const firmware::protocol::C
 }
 
 CommandRepeater::CommandRepeater(uint8_t node_id, const firmware::protocol::Command& command,
-                                 uint8_t first_counter, const RepeatPlan& plan, SteadyTime start)
+                                 uint8_t first_counter, const RepeatPlan& plan, SteadyTime start,
+                                 const std::optional<firmware::protocol::Command>& lead)
     : node_id_(node_id),
       command_(command),
       message_id_(static_cast<uint8_t>(firmware::protocol::message_for(command.kind))),
@@ -80,6 +94,10 @@ CommandRepeater::CommandRepeater(uint8_t node_id, const firmware::protocol::Comm
       rate_Hz_(plan.rate_Hz),
       ack_timeout_(from_seconds(plan.ack_timeout_s)) {
   tally_.planned = repeat_slot_count(plan.rate_Hz, plan.duration_s);
+  if (lead) {
+    tally_.lead.emplace();
+    tally_.lead->command = *lead;
+  }
 }
 
 SteadyTime CommandRepeater::slot_time(uint64_t slot) const {
@@ -90,6 +108,12 @@ SteadyTime CommandRepeater::slot_time(uint64_t slot) const {
 
 std::optional<hal::CanFrame> CommandRepeater::frame_due(SteadyTime now) {
   expire(now);
+  if (lead_due()) {
+    if (now < start_) return std::nullopt;
+    lead_tried_ = true;
+    unreported_counter_ = encoder_.next_counter();
+    return encoder_.encode(tally_.lead->command);
+  }
   if (!slots_left() || now < slot_time(next_slot_)) return std::nullopt;
   // The latest slot already due. The arithmetic estimate saves stepping through every slot of a
   // long stall; slot_time(), which every other decision uses, settles the boundary.
@@ -113,6 +137,17 @@ void CommandRepeater::sent(SteadyTime now, bool queued) {
   if (!unreported_counter_) return;
   const uint8_t counter = *unreported_counter_;
   unreported_counter_.reset();
+  if (tally_.lead && !tally_.lead->sent && !tally_.lead->send_failed) {  // it was the lead
+    if (!queued) {
+      tally_.lead->send_failed = true;
+      stop(now);  // the drive was not enabled: nothing to keep alive
+      return;
+    }
+    tally_.lead->sent = true;
+    lead_counter_ = counter;
+    lead_waiting_ = Waiting{true, now + ack_timeout_};
+    return;
+  }
   if (!queued) {
     ++tally_.send_failures;
     encoder_.set_next_counter(counter);  // it never reached the bus: the next frame reuses it
@@ -129,6 +164,7 @@ void CommandRepeater::sent(SteadyTime now, bool queued) {
 void CommandRepeater::receive(SteadyTime now, const hal::CanFrame& frame) {
   expire(now);
   const std::optional<AckFrame> ack = decode_ack(frame, node_id_);
+  if (ack && receive_lead(now, *ack)) return;
   if (!ack || ack->message_id != message_id_) return;
   Waiting& w = waiting_[ack->counter & 0x0F];
   // Not waiting: another host's frame, or an ack that came after its frame was given up.
@@ -142,6 +178,17 @@ void CommandRepeater::receive(SteadyTime now, const hal::CanFrame& frame) {
   }
 }
 
+bool CommandRepeater::receive_lead(SteadyTime now, const AckFrame& ack) {
+  if (!lead_waiting_.active || ack.counter != lead_counter_ ||
+      ack.message_id != uint8_t(firmware::protocol::message_for(tally_.lead->command.kind))) {
+    return false;
+  }
+  lead_waiting_.active = false;
+  tally_.lead->result = ack.ack.result;
+  if (ack.ack.result != CommandResult::accepted) stop(now);  // not enabled: stop feeding it
+  return true;
+}
+
 void CommandRepeater::stop(SteadyTime now) {
   if (stopped_) return;
   if (next_slot_ < tally_.planned) {
@@ -152,12 +199,13 @@ void CommandRepeater::stop(SteadyTime now) {
 
 bool CommandRepeater::finished(SteadyTime now) {
   expire(now);
-  if (slots_left() || unreported_counter_) return false;
+  if (slots_left() || unreported_counter_ || lead_due() || lead_waiting_.active) return false;
   return std::none_of(waiting_.begin(), waiting_.end(), [](const Waiting& w) { return w.active; });
 }
 
 SteadyTime CommandRepeater::next_event() const {
-  SteadyTime next = slots_left() ? slot_time(next_slot_) : SteadyTime::max();
+  SteadyTime next = lead_due() ? start_ : slots_left() ? slot_time(next_slot_) : SteadyTime::max();
+  if (lead_waiting_.active) next = std::min(next, lead_waiting_.deadline);
   for (const Waiting& w : waiting_) {
     if (w.active) next = std::min(next, w.deadline);
   }
@@ -165,6 +213,10 @@ SteadyTime CommandRepeater::next_event() const {
 }
 
 void CommandRepeater::expire(SteadyTime now) {
+  if (lead_waiting_.active && now >= lead_waiting_.deadline) {
+    lead_waiting_.active = false;  // the repetition goes on: the enable may have been obeyed
+    tally_.lead->unanswered = true;
+  }
   for (Waiting& w : waiting_) {
     if (w.active && now >= w.deadline) give_up(w);
   }

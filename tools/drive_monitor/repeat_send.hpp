@@ -22,6 +22,12 @@
 /// Acks: no stop-and-wait; each sent frame waits, keyed by its counter, for the command_ack with
 /// its message and counter. It counts as unanswered if none came within ack_timeout_s, or by the
 /// time its counter comes round again 16 frames later (an ack could no longer be told apart).
+///
+/// Lead (send set-speed --enable): one other command sent at the start, before slot 0, with the
+/// first counter; slot 0 follows at once with the next. One process does both, so the repeated
+/// frames feed the command watchdog from the tick the enable arms it. A lead the socket refused
+/// or the drive rejected stops the repetition: a drive that was not enabled has nothing to keep
+/// alive.
 #include <array>
 #include <chrono>
 #include <cstdint>
@@ -30,6 +36,7 @@
 
 #include "firmware/protocol/commands.hpp"
 #include "hal/can_bus.hpp"
+#include "tools/drive_monitor/send_command.hpp"
 
 namespace imd::monitor {
 
@@ -65,6 +72,16 @@ struct RepeatTally {
   /// Set when stop() came before the last slot: seconds from the start.
   std::optional<double> stopped_after_s;
 
+  /// The lead command and what became of it (only with a lead).
+  struct Lead {
+    firmware::protocol::Command command;
+    bool sent = false;                                        ///< the socket took it
+    bool send_failed = false;                                 ///< the socket refused it
+    std::optional<firmware::protocol::CommandResult> result;  ///< its ack's
+    bool unanswered = false;                                  ///< sent, no ack in time
+  };
+  std::optional<Lead> lead;
+
   uint64_t rejected_total() const;
 };
 
@@ -74,19 +91,22 @@ enum class RepeatVerdict : uint8_t {
   rejected,          ///< the drive rejected at least one frame
   not_all_accepted,  ///< none rejected, but some were unanswered or not sent (or none was sent)
 };
+/// With a lead: rejected if it was, all_accepted only if it was accepted too.
 RepeatVerdict verdict(const RepeatTally& tally);
 
 /// One line, e.g. "sent 60 set_speed 30.000 rad/s frames at 20 Hz: 58 accepted, 2 rejected
 /// (1 stale_counter, 1 not_allowed), 0 unanswered", then only what is not zero: frames not sent,
-/// slots skipped, and an early stop.
+/// slots skipped, and an early stop. A lead comes first: "enable: accepted; sent 60 ...".
 std::string repeat_summary(const RepeatTally& tally, const firmware::protocol::Command& command,
                            double rate_Hz);
 
 class CommandRepeater {
  public:
-  /// The first frame is due at `start` and carries `first_counter`.
+  /// The first frame is due at `start` and carries `first_counter`; with a `lead`, that frame
+  /// is the lead and slot 0 follows at once.
   CommandRepeater(uint8_t node_id, const firmware::protocol::Command& command,
-                  uint8_t first_counter, const RepeatPlan& plan, SteadyTime start);
+                  uint8_t first_counter, const RepeatPlan& plan, SteadyTime start,
+                  const std::optional<firmware::protocol::Command>& lead = std::nullopt);
 
   /// The frame to send now if a slot is due (nullopt: not yet, or no slot left). The caller
   /// must report at once whether the socket took it: sent(now, queued).
@@ -116,6 +136,9 @@ class CommandRepeater {
   };
 
   bool slots_left() const { return !stopped_ && next_slot_ < tally_.planned; }
+  bool lead_due() const { return tally_.lead && !stopped_ && !lead_tried_; }
+  /// The lead's ack, if `ack` is it: true when consumed.
+  bool receive_lead(SteadyTime now, const AckFrame& ack);
   /// Counts the frames whose ack deadline has passed as unanswered.
   void expire(SteadyTime now);
   void give_up(Waiting& w);
@@ -131,6 +154,9 @@ class CommandRepeater {
   bool stopped_ = false;
   std::optional<uint8_t> unreported_counter_;  ///< frame_due() returned it, sent() not yet called
   std::array<Waiting, 16> waiting_{};          ///< by alive counter
+  bool lead_tried_ = false;                    ///< frame_due() returned the lead
+  uint8_t lead_counter_ = 0;
+  Waiting lead_waiting_{};
   RepeatTally tally_;
 };
 

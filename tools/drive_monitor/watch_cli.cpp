@@ -154,8 +154,9 @@ CLI::App* add_watch_command(CLI::App& app, WatchOptions& o) {
   watch->footer(
       "Frames that are not the node's (error, 29-bit, CAN FD and remote frames, other nodes, "
       "unknown messages) are skipped, and counted in a summary line on standard error.\n"
-      "Exit codes: 0 success, 1 the CSV could not be written, 2 bad input (command line, "
-      "interface, malformed log line), 4 no frame from the node (is --node right?).");
+      "Exit codes: 0 success, 1 writing the CSV failed during the watch (disk full), 2 bad "
+      "input (command line, interface, a CSV that cannot be created, malformed log line), 4 no "
+      "frame from the node (is --node right?).");
   auto* can = watch->add_option("--can", o.can, "CAN interface (SocketCAN), e.g. can0");
   watch->add_option("--log", o.log, "candump -L log file instead of an interface")->excludes(can);
   watch->add_option("--node", o.node, "Node id of the drive")

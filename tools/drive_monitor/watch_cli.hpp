@@ -2,8 +2,9 @@
 /// drive_monitor watch: decodes one node's frames from a CAN interface or a candump -L log into
 /// the status table and a telemetry CSV; skips and counts everything else a shared bus carries
 /// and ends with a summary line (capture_report.hpp). Exit codes: 0 success, kExitOutputError
-/// the CSV could not be written, kExitBadInput bad input (command line, interface, malformed
-/// log line), kExitNoAnswer no frame at all from the node.
+/// writing the CSV failed during the watch (disk full), kExitBadInput bad input before anything
+/// ran (command line, interface, a CSV that cannot be created) or a malformed log line,
+/// kExitNoAnswer no frame at all from the node.
 #include <CLI/CLI.hpp>
 
 #include <string>

@@ -5,22 +5,24 @@
 //             [--motor-file PATH] [--motor-out PATH]
 //
 // Prints the summary (JSON) on standard output. Exit codes: 0 success, 2 bad input (command
-// line or scenario file, or --plot without python3-matplotlib), 1 an output could not be
-// written, 3 a commissioning run identified no motor (the summary says why).
+// line or scenario file, an output path that cannot be written, or --plot without
+// python3-matplotlib: all checked before the run), 1 an output could not be written during or
+// after the run, 3 a commissioning run identified no motor (the summary says why).
 #include <imd_version.hpp>
 #include <fmt/format.h>
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <iostream>
-#include <iterator>
 #include <optional>
 #include <string>
 #include <system_error>
+#include <utility>
 #include <vector>
 
 #include <fcntl.h>
@@ -37,71 +39,15 @@ extern char** environ;
 #include "hal_sim/scenario.hpp"
 #include "tools/can_log/candump_log.hpp"
 #include "tools/data_path.hpp"
+#include "tools/drive_sim/csv_writer.hpp"
 #include "tools/drive_sim/summary_json.hpp"
+#include "tools/output_path.hpp"
 
 namespace {
 
 constexpr int kExitBadInput = 2;
 constexpr int kExitOutputFailed = 1;
 constexpr int kExitNotIdentified = 3;
-
-/// The CSV columns (docs/scenarios.md): one table for the header and the rows.
-struct Column {
-  const char* name;
-  double (*value)(const imd::sim::SimRow&);
-};
-#define IMD_COLUMN(field)                                                          \
-  Column {                                                                         \
-#field, [](const imd::sim::SimRow& r) { return static_cast<double>(r.field); } \
-  }
-const Column kColumns[] = {
-    IMD_COLUMN(t_s),
-    IMD_COLUMN(omega_mech_rad_s),
-    IMD_COLUMN(omega_ref_rad_s),
-    IMD_COLUMN(omega_est_rad_s),
-    IMD_COLUMN(flux2_Wb2),
-    IMD_COLUMN(flux2_ref_Wb2),
-    IMD_COLUMN(flux2_est_Wb2),
-    IMD_COLUMN(load_Nm),
-    IMD_COLUMN(load_est_Nm),
-    IMD_COLUMN(i_alpha_A),
-    IMD_COLUMN(i_beta_A),
-    IMD_COLUMN(v_alpha_V),
-    IMD_COLUMN(v_beta_V),
-    IMD_COLUMN(discriminant),
-    IMD_COLUMN(c_k),
-    IMD_COLUMN(flux_A_Wb),
-    IMD_COLUMN(flux_B_Wb),
-    IMD_COLUMN(flux_A_est_Wb),
-    IMD_COLUMN(flux_B_est_Wb),
-    IMD_COLUMN(theta_mech_rad),
-    IMD_COLUMN(theta_est_rad),
-    IMD_COLUMN(torque_Nm),
-    IMD_COLUMN(torque_ref_Nm),
-    IMD_COLUMN(y2),
-    IMD_COLUMN(y2_ref),
-    IMD_COLUMN(stator_flux2_Wb2),
-    IMD_COLUMN(stator_flux2_ref_Wb2),
-    IMD_COLUMN(i_hold_err_A),
-    IMD_COLUMN(iol_boundary),
-    IMD_COLUMN(state),
-    IMD_COLUMN(saturated),
-    IMD_COLUMN(omega_ref_cmd_rad_s),
-    IMD_COLUMN(flux2_ctrl_est_Wb2),
-    IMD_COLUMN(flux2_ctrl_ref_Wb2),
-    IMD_COLUMN(iA_est_A),
-    IMD_COLUMN(iB_est_A),
-    IMD_COLUMN(v_bus_meas_V),
-    IMD_COLUMN(u_alpha_cmd_V),
-    IMD_COLUMN(u_beta_cmd_V),
-    IMD_COLUMN(rr_est_Ohm),
-    IMD_COLUMN(Rr_plant_Ohm),
-    IMD_COLUMN(limited),
-    IMD_COLUMN(stop),
-    IMD_COLUMN(brake_engaged),
-};
-#undef IMD_COLUMN
-
 
 /// A commissioning run's outcome on standard error, and its motor file: 0, or the exit code.
 int report_commissioning(const imd::sim::Scenario& s, const imd::sim::Summary& r,
@@ -175,8 +121,9 @@ int run_program(std::vector<std::string> args, bool quiet = false) {
 /// Why --plot PATH cannot be drawn, checked before the run: the format (what matplotlib's Agg
 /// backend writes, by extension) and python3 with matplotlib and numpy. Empty: it can.
 std::string plot_problem(const std::string& path) {
-  const std::string extension = std::filesystem::path(path).extension().string();
-  if (extension != ".png" && extension != ".pdf" && extension != ".svg") {
+  std::string extension = std::filesystem::path(path).extension().string();
+  for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  if (extension != ".png" && extension != ".pdf" && extension != ".svg") {  // out.PNG too
     return fmt::format("--plot {}: the file name must end in .png, .pdf or .svg", path);
   }
   if (run_program({"/usr/bin/python3", "-c", "import matplotlib, numpy"}, true) != 0) {
@@ -185,6 +132,15 @@ std::string plot_problem(const std::string& path) {
                        path);
   }
   return "";
+}
+
+/// --motor-file: an existing file, relative to the working directory (a scenario's motor files
+/// are relative to the scenario's).
+std::string model_file_problem(const std::string& path) {
+  std::error_code status;
+  if (std::filesystem::is_regular_file(path, status)) return "";
+  return fmt::format("{}: no such file (a relative path is taken from the working directory, {})",
+                     path, std::filesystem::current_path(status).string());
 }
 
 /// --duration-s: a simulated time in (0, 3600] s, as simulation.duration_s.
@@ -228,7 +184,7 @@ int main(int argc, char** argv) {
                  "Give the controller this motor file instead of the scenario's motor; the "
                  "simulated motor stays the scenario's (e.g. an identified motor on the true "
                  "plant)")
-      ->check(CLI::ExistingFile);
+      ->check(CLI::Validator(model_file_problem, "FILE"));
   app.add_option("--motor-out", motor_out_path,
                  "A commissioning scenario ([nameplate]): write the identified motor to this "
                  "motor file");
@@ -238,7 +194,25 @@ int main(int argc, char** argv) {
     const int code = app.exit(error);
     return code == 0 ? 0 : kExitBadInput;
   }
-  if (duration_s) overrides.push_back(fmt::format("simulation.duration_s={}", *duration_s));
+  // Each override names its own flag in messages: --duration-s is not a --set.
+  std::vector<imd::sim::ScenarioOverride> flagged;
+  for (const std::string& o : overrides) flagged.push_back({o, "--set " + o});
+  if (duration_s) {
+    overrides.push_back(fmt::format("simulation.duration_s={}", *duration_s));
+    flagged.push_back({overrides.back(), fmt::format("--duration-s {}", *duration_s)});
+  }
+  for (const auto& [flag, path] : {std::pair{"--csv", &csv_path},
+                                   {"--summary-json", &summary_path},
+                                   {"--plot", &plot_path},
+                                   {"--can-log", &can_log_path},
+                                   {"--motor-out", &motor_out_path}}) {
+    if (path->empty()) continue;
+    if (const std::string problem = imd::tools::output_path_problem(flag, *path);
+        !problem.empty()) {
+      std::cerr << "drive_sim: " << problem << '\n';
+      return kExitBadInput;
+    }
+  }
   if (!plot_path.empty()) {  // before a run that may be long, not after it
     if (const std::string problem = plot_problem(plot_path); !problem.empty()) {
       std::cerr << "drive_sim: " << problem << '\n';
@@ -248,8 +222,8 @@ int main(int argc, char** argv) {
 
   imd::sim::Scenario scenario;
   try {
-    scenario = imd::sim::load_scenario(
-        scenario_path, overrides,
+    scenario = imd::sim::load_scenario_with_flags(
+        scenario_path, flagged,
         model_file ? std::optional<std::filesystem::path>(*model_file) : std::nullopt);
     if (!motor_out_path.empty() && !scenario.commissioning) {
       throw imd::sim::ConfigError(scenario_path +
@@ -281,28 +255,20 @@ int main(int argc, char** argv) {
         (std::filesystem::temp_directory_path() / fmt::format("drive_sim_{}.csv", ::getpid()))
             .string();
   std::FILE* csv = nullptr;
+  std::optional<imd::tools::CsvWriter> csv_writer;
   if (!csv_path.empty()) {
     csv = std::fopen(csv_path.c_str(), "w");
     if (csv == nullptr) {
       std::cerr << "drive_sim: cannot write " << csv_path << '\n';
       return kExitOutputFailed;
     }
-    for (const Column& column : kColumns) {
-      std::fputs(column.name, csv);
-      std::fputc(&column == &kColumns[std::size(kColumns) - 1] ? '\n' : ',', csv);
-    }
+    csv_writer.emplace(csv);
+    csv_writer->header();
   }
 
   imd::sim::RunCallbacks callbacks;
-  if (csv != nullptr) {
-    callbacks.row = [&](const imd::sim::SimRow& r) {
-      fmt::memory_buffer line;
-      for (const Column& column : kColumns) {
-        fmt::format_to(std::back_inserter(line), "{:.10g},", column.value(r));
-      }
-      line[line.size() - 1] = '\n';
-      std::fwrite(line.data(), 1, line.size(), csv);
-    };
+  if (csv_writer) {
+    callbacks.row = [&csv_writer](const imd::sim::SimRow& r) { csv_writer->row(r); };
   }
   if (can_log != nullptr) {
     // The log reads as candump -L -x on the host's interface: the drive's frames received,
@@ -324,12 +290,8 @@ int main(int argc, char** argv) {
                  scenario.duration_s, wall_s);
   };
   imd::sim::Summary summary;
-  bool written = true;
-  try {
-    summary = imd::sim::run_scenario(scenario, callbacks);
-  } catch (const std::system_error&) {  // fmt reports a failed CSV write (disk full) this way
-    written = false;
-  }
+  summary = imd::sim::run_scenario(scenario, callbacks);
+  bool written = !csv_writer || csv_writer->finish();
   if (can_log != nullptr && (std::ferror(can_log) != 0 || std::fclose(can_log) != 0)) {
     std::cerr << "\ndrive_sim: cannot write " << can_log_path << " (disk full?)\n";
     return kExitOutputFailed;

@@ -27,7 +27,7 @@ using imd::firmware::DriveConfig;
 
 // A new field must be written here too: these sizes fail the build until it is.
 static_assert(sizeof(DriveConfig) == 472, "DriveConfig changed: write its new fields below");
-static_assert(sizeof(imd::sim::SimBoardConfig) == 176, "SimBoardConfig changed: write it below");
+static_assert(sizeof(imd::sim::SimBoardConfig) == 184, "SimBoardConfig changed: write it below");
 static_assert(sizeof(imd::control::MotorParameters) == 64, "MotorParameters changed");
 
 class Writer {
@@ -99,6 +99,9 @@ void write_motor(Writer& w, const std::string& p, const imd::control::MotorParam
 void write_board(Writer& w, const imd::sim::SimBoardConfig& b) {
   w.number("board.period_s", b.period_s);
   w.integer("board.substeps", b.substeps);
+  w.line("board.integrator", b.integrator == imd::sim::PlantIntegrator::rk6
+                                 ? "sim::PlantIntegrator::rk6"
+                                 : "sim::PlantIntegrator::rk4");
   w.integer("board.pwm_latency_ticks", b.pwm_latency_ticks);
   w.line("board.inner_feedback", b.inner_feedback == imd::sim::InnerFeedback::digital
                                      ? "sim::InnerFeedback::digital"

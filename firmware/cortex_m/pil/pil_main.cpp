@@ -16,6 +16,7 @@
 #include "firmware/cortex_m/pil/mps2_an386.hpp"
 #include "firmware/cortex_m/pil/pil_options.hpp"
 #include "firmware/cortex_m/pil/pil_report.hpp"
+#include "firmware/cortex_m/pil/recompute_probe.hpp"
 #include "firmware/drive.hpp"
 #include "hal_sim/drive/embedded_scenario.hpp"
 #include "hal_sim/drive/lookahead_references.hpp"
@@ -124,6 +125,8 @@ int run(const sim::EmbeddedScenario& s, const PilOptions& options, hal::ResetCau
   PilReport report(console);
   static const mps2::FreeRunningTimer service_clock;
   report.start(s, drive_config, timer.counts_per_period());  // with the stack used so far: the start-up's
+  // What the tracker's retune costs in the discretization alone, before the tick starts.
+  report.recompute(measure_recompute(service_clock, s.motor, drive_config.sample_period_s, 8));
 
   const double duration_s =
       options.duration_ms > 0 ? double(options.duration_ms) * 1e-3 : s.duration_s;

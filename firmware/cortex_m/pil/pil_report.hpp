@@ -5,6 +5,7 @@
 /// tests/qemu/pil_test.py parses.
 #include <cstdint>
 
+#include "firmware/cortex_m/pil/recompute_probe.hpp"
 #include "firmware/drive.hpp"
 #include "hal_sim/drive/embedded_scenario.hpp"
 #include "hal_sim/drive/stage_totals.hpp"
@@ -29,6 +30,8 @@ class PilReport {
     retune_counts_total_ += counts;
     if (counts > retune_counts_max_) retune_counts_max_ = counts;
   }
+  /// The float discretization's recompute (recompute_probe.hpp): instructions per run and stack.
+  void recompute(const RecomputeCost& cost) noexcept;
   /// The first heartbeat the drive sent after start-up: its reset cause.
   void first_heartbeat(const hal::CanFrame& frame) noexcept;
   /// The largest interval between two control stages, and the watchdog's period (counts).

@@ -28,6 +28,7 @@ const sim::EmbeddedScenario kSeed000Realistic = [] {
   s.plant.friction_Nms = 0;
   s.board.period_s = 0.0001;
   s.board.substeps = 10;
+  s.board.integrator = sim::PlantIntegrator::rk6;
   s.board.pwm_latency_ticks = 1;
   s.board.inner_feedback = sim::InnerFeedback::digital;
   s.board.current_source = false;

@@ -17,10 +17,11 @@ from .errors import (CommandRejected, DriveError, IdentifyFailed, NoAnswer, Para
 from .frames import FrameDecoder
 from .logbus import LogFormatError, LogReplayBus, read_log
 from .monitor import Monitor
+from .socketcand_bus import SocketcandBus, SocketcandError
 from .status import active_faults
 from .telemetry import TelemetrySample
 
 __all__ = ["__version__", "CommandEncoder", "CommandRejected", "Drive", "DriveError",
            "FrameDecoder", "IdentifyFailed", "LogFormatError", "LogReplayBus", "Monitor",
-           "NoAnswer", "ParameterRefused", "ProtocolMismatch", "TelemetrySample",
-           "active_faults", "read_log"]
+           "NoAnswer", "ParameterRefused", "ProtocolMismatch", "SocketcandBus", "SocketcandError",
+           "TelemetrySample", "active_faults", "read_log"]

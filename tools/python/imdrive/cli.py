@@ -9,10 +9,10 @@ import math
 import sys
 import time
 
-import can
-
 from . import capture_report, table
 from ._version import build_version
+from .bus_open import BusOpenError
+from .bus_open import open_bus as open_named_bus
 from .drive import Drive
 from .errors import CommandRejected, DriveError, IdentifyFailed, NoAnswer, ParameterRefused
 from .logbus import LogFormatError, LogReplayBus
@@ -61,6 +61,9 @@ def _seconds(text):
 def _bus_options(parser, log=False):
     group = parser.add_mutually_exclusive_group(required=True)
     group.add_argument("--can", metavar="IFACE", help="SocketCAN interface, e.g. can0")
+    group.add_argument("--socketcand", metavar="HOST:PORT",
+                       help="a socketcand server, e.g. drive_hil --can socketcand:29536 on a "
+                       "machine without SocketCAN")
     group.add_argument("--interface", metavar="NAME",
                        help="another python-can interface (with --channel), e.g. virtual")
     if log:
@@ -110,13 +113,10 @@ def open_bus(args):
     the Monitor decodes the node's frames and counts the others, by reason and by node."""
     if getattr(args, "log", None):
         return LogReplayBus(args.log)
-    if args.interface and not args.channel:
-        raise UsageError(f"--interface {args.interface} needs --channel")
-    interface, channel = ("socketcan", args.can) if args.can else (args.interface, args.channel)
     try:
-        return can.Bus(interface=interface, channel=channel)
-    except (can.CanError, OSError, ValueError, ImportError) as error:
-        raise UsageError(f"cannot open {interface} {channel}: {error}") from None
+        return open_named_bus(args.can, args.interface, args.channel, args.socketcand)
+    except BusOpenError as error:
+        raise UsageError(str(error)) from None
 
 
 def command_values(word, text):
@@ -181,7 +181,8 @@ def finish_watch(monitor, samples, bus, args):
               f"latched: {', '.join(active_faults(hb)) or 'none'}", file=sys.stderr)
     if monitor.protocol_error is not None:
         print(f"imdrive: warning: {monitor.protocol_error}", file=sys.stderr)
-    source = args.log or args.can or f"{args.interface} {args.channel}"
+    source = args.log or args.can or (args.socketcand and f"socketcand {args.socketcand}") \
+        or f"{args.interface} {args.channel}"
     warning = capture_report.silent_node_warning(monitor, source)
     if warning is not None:
         print(f"imdrive: {warning}", file=sys.stderr)

@@ -1,4 +1,5 @@
-"""The client: one drive on a python-can bus (SocketCAN, the `virtual` interface, a log replay).
+"""The client: one drive on a python-can bus (SocketCAN, a socketcand server such as drive_hil
+--can socketcand:PORT through SocketcandBus, the `virtual` interface, a log replay).
 
 A receive thread feeds every frame to a Monitor; commands are sent from the caller's thread
 with the next alive counter and wait for their command_ack. The counter is learnt from the

@@ -119,7 +119,7 @@ MESSAGES = (
         Signal("brake", start_bit=47, length_bits=1, is_signed=False, scale_num=1,
                scale_den=1, offset=0.0, unit="", minimum=0.0, maximum=1.0,
                is_float=False, values=(),
-               comment="the holding brake is engaged (its line not driven)"),
+               comment="engaged: a brake line is configured and not driven"),
         Signal("reset_cause", start_bit=6, length_bits=2, is_signed=False, scale_num=1,
                scale_den=1, offset=0.0, unit="", minimum=0.0, maximum=3.0,
                is_float=False, values=RESET_CAUSE_VALUES,
