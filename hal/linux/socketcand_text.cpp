@@ -191,6 +191,63 @@ std::string format_socketcand_frame(const CanFrame& frame, int64_t seconds, int6
   return text;
 }
 
+SocketcandReply parse_socketcand_reply(std::string_view words) {
+  using Kind = SocketcandReply::Kind;
+  const std::vector<std::string_view> w = split_words(words);
+  SocketcandReply r;
+  if (w.size() == 1 && (w[0] == "ok" || w[0] == "hi" || w[0] == "echo")) {
+    r.kind = w[0] == "ok" ? Kind::ok : w[0] == "hi" ? Kind::hi : Kind::echo;
+    return r;
+  }
+  if (!w.empty() && w[0] == "error") {
+    r.kind = Kind::error;
+    r.text = std::string(trim(words.substr(words.find("error") + 5)));
+    return r;
+  }
+  if (w.empty() || w[0] != "frame") {
+    r.kind = Kind::other;
+    r.text = "unexpected message " + quoted(words);
+    return r;
+  }
+  r.kind = Kind::bad;
+  uint32_t id = 0;
+  if (w.size() < 3 || w.size() > 4) {
+    r.text = "frame needs ID TIME [DATA]: " + quoted(words);
+  } else if (w[1].size() == 8 && parse_hex(w[1], 8, id)) {
+    r.kind = Kind::other;
+    r.text = "29-bit frame " + std::string(w[1]) + " skipped: the drive uses 11-bit identifiers";
+  } else if (!parse_hex(w[1], 3, id) || id > 0x7FF) {
+    r.text = "frame: identifier " + quoted(w[1]) + " is not 11-bit hex";
+  } else if (w.size() == 4 && (w[3].size() % 2 != 0 || w[3].size() > 16)) {
+    r.text = "frame " + std::string(w[1]) + ": data " + quoted(w[3]) + " is not 0..8 hex bytes";
+  } else {
+    r.frame.id = static_cast<uint16_t>(id);
+    const std::string_view data = w.size() == 4 ? w[3] : std::string_view();
+    r.frame.length = static_cast<uint8_t>(data.size() / 2);
+    for (std::size_t i = 0; i < r.frame.length; ++i) {
+      uint32_t byte = 0;
+      if (!parse_hex(data.substr(2 * i, 2), 2, byte)) {
+        r.text = "frame " + std::string(w[1]) + ": data " + quoted(data) + " is not hex";
+        return r;
+      }
+      r.frame.data[i] = static_cast<uint8_t>(byte);
+    }
+    r.kind = Kind::frame;
+  }
+  return r;
+}
+
+std::string format_socketcand_send(const CanFrame& frame) {
+  const std::size_t length = frame.length <= 8 ? frame.length : 8;
+  char text[64];
+  int n = std::snprintf(text, sizeof text, "< send %03X %zu", frame.id & 0x7FFu, length);
+  for (std::size_t i = 0; i < length; ++i) {
+    n += std::snprintf(text + n, sizeof text - static_cast<std::size_t>(n), " %02X", frame.data[i]);
+  }
+  std::snprintf(text + n, sizeof text - static_cast<std::size_t>(n), " >");
+  return text;
+}
+
 std::string format_socketcand_error(std::string_view text) {
   std::string out = "< error ";
   for (const char c : text) out += (c == '<' || c == '>') ? '?' : c;

@@ -1,8 +1,9 @@
 #pragma once
 /// The text of the socketcand protocol (github.com/linux-can/socketcand, doc/protocol.md), as
-/// far as a raw-mode server needs it: every message is `< WORDS >` on a TCP stream, with no
-/// line ends and no length prefix, so a message may arrive split over several reads or many
-/// in one read. Runs in the server's I/O thread (it allocates), never in the tick.
+/// far as a raw-mode server and its client need it: every message is `< WORDS >` on a TCP
+/// stream, with no line ends and no length prefix, so a message may arrive split over several
+/// reads or many in one read. Runs in the server's I/O thread or in a host tool (it
+/// allocates), never in the tick.
 #include <cstddef>
 #include <cstdint>
 #include <optional>
@@ -55,6 +56,22 @@ SocketcandCommand parse_socketcand(std::string_view words);
 /// time, the data as contiguous upper-case hex (socketcand's own format; no data leaves two
 /// spaces before '>', as socketcand writes it).
 std::string format_socketcand_frame(const CanFrame& frame, int64_t seconds, int64_t micros);
+
+/// What one server message says, as a client reads it (SocketcandPiece::text).
+struct SocketcandReply {
+  enum class Kind { frame, ok, hi, echo, error, other, bad };
+  Kind kind = Kind::bad;
+  CanFrame frame;    ///< frame: the frame, checked
+  std::string text;  ///< error: the server's words; other, bad: what was not understood
+};
+
+/// Parses the words of one server message. `frame ID SECS.USECS [HEX]` takes an 11-bit
+/// identifier (1 to 3 hex digits) and 0..8 bytes as contiguous hex; a 29-bit identifier
+/// (8 digits) is `other` (the drive has none), a malformed frame is `bad`.
+SocketcandReply parse_socketcand_reply(std::string_view words);
+
+/// `< send 123 4 1A 22 3 44 >` for a client: the identifier in hex, LEN, each byte in hex.
+std::string format_socketcand_send(const CanFrame& frame);
 
 /// `< error TEXT >`, with '<' and '>' in TEXT replaced so that it stays one message.
 std::string format_socketcand_error(std::string_view text);

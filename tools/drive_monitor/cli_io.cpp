@@ -67,17 +67,13 @@ const CLI::Validator kSeconds(
     },
     "SECONDS");
 
-void wait_readable(const hal::SocketCanBus& bus, Clock::time_point deadline) {
+void wait_readable(const LiveBus& bus, Clock::time_point deadline) {
   const int64_t left_ns = std::max<int64_t>(
       0, std::chrono::duration_cast<std::chrono::nanoseconds>(deadline - Clock::now()).count());
   const timespec timeout{static_cast<time_t>(left_ns / 1'000'000'000),
                          static_cast<long>(left_ns % 1'000'000'000)};
   pollfd fd{bus.native_handle(), POLLIN, 0};
   ::ppoll(&fd, 1, &timeout, g_wait_mask);
-}
-
-bool interface_lost(const hal::SocketCanBus& bus) {
-  return bus.last_errno() == ENODEV || bus.last_errno() == ENETDOWN;
 }
 
 }  // namespace imd::monitor::cli

@@ -7,7 +7,7 @@
 #include <csignal>
 #include <string>
 
-#include "hal/linux/socketcan_bus.hpp"
+#include "tools/drive_monitor/live_bus.hpp"
 
 namespace imd::monitor::cli {
 
@@ -46,17 +46,14 @@ int fail(const std::string& message, int code = kExitBadInput);
 /// A duration in (0, 1e7] s; CLI11's PositiveNumber lets NaN through.
 extern const CLI::Validator kSeconds;
 
-/// Waits until the socket has data or `deadline` passes (or a signal arrives). ppoll rather
+/// Waits until the bus has data or `deadline` passes (or a signal arrives). ppoll rather
 /// than poll for its nanosecond timeout (poll's milliseconds would make a wait up to a whole
 /// period late at 1000 Hz) and its atomic signal mask (StopSignals).
-void wait_readable(const hal::SocketCanBus& bus, Clock::time_point deadline);
-
-/// The interface is gone or down: waiting for it to come back is not this tool's job.
-bool interface_lost(const hal::SocketCanBus& bus);
+void wait_readable(const LiveBus& bus, Clock::time_point deadline);
 
 /// Receives until `accept(frame)` returns true or `wait_s` passes.
 template <typename Accept>
-bool receive_until(hal::SocketCanBus& bus, double wait_s, Accept accept) {
+bool receive_until(LiveBus& bus, double wait_s, Accept accept) {
   const Clock::time_point deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(
                                                         std::chrono::duration<double>(wait_s));
   hal::CanFrame frame;
@@ -64,7 +61,7 @@ bool receive_until(hal::SocketCanBus& bus, double wait_s, Accept accept) {
     while (bus.try_receive(frame)) {
       if (accept(frame)) return true;
     }
-    if (Clock::now() >= deadline) return false;
+    if (Clock::now() >= deadline || bus.lost()) return false;
     wait_readable(bus, deadline);
   }
   return false;

@@ -1,16 +1,18 @@
 // drive_monitor: watches a drive's CAN frames (live, or from a candump -L log) and sends it
 // commands.
 //
-//   drive_monitor watch (--can IFACE | --log FILE) [--node N] [--csv PATH] [--table | --no-table]
+//   drive_monitor watch (BUS | --log FILE) [--node N] [--csv PATH] [--table | --no-table]
 //                       [--duration-s S]
-//   drive_monitor send --can IFACE --node N COMMAND [VALUE] [--counter C] [--wait-heartbeat-s S]
+//   drive_monitor send BUS --node N COMMAND [VALUE] [--counter C] [--wait-heartbeat-s S]
 //                      [--wait-ack-s S] [--repeat-hz F --for-s S [--enable]]
-//   drive_monitor parameters --can IFACE --node N [--set KEY=VALUE]... [--motor-file PATH]
+//   drive_monitor parameters BUS --node N [--set KEY=VALUE]... [--motor-file PATH]
 //                            [--save] [--motor-out PATH] [--wait-s S] [--wait-heartbeat-s S]
-//   drive_monitor identify --can IFACE --node N [--rotate] [--motor-out PATH] [--timeout-s S]
+//   drive_monitor identify BUS --node N [--rotate] [--motor-out PATH] [--timeout-s S]
 //
+// BUS is --can IFACE (SocketCAN) or --socketcand HOST:PORT (a socketcand server in raw mode,
+// such as drive_hil --can socketcand:PORT, for a machine without SocketCAN).
 // watch decodes node N's frames (default 1); the CSV's time_s is the log's timestamp, or with
-// --can the seconds since watch started. Everything else a shared bus carries (error frames,
+// a live bus the seconds since watch started. Everything else a shared bus carries (error frames,
 // 29-bit, CAN FD and remote frames, other nodes, unknown messages) is skipped and counted; one
 // summary line on standard error ends the watch, and a warning when node N sent nothing.
 // send learns the alive counter from the heartbeat.
@@ -39,10 +41,10 @@
 // identify starts the commissioning (the drive's record must hold the nameplate), prints its
 // progress, and on success reads the identified record back as parameters does; exit code 3
 // when the drive refuses or the run fails (the reason is printed), 4 when it does not answer.
-#include <imd_version.hpp>
 #include <poll.h>
 #include <unistd.h>
 #include <CLI/CLI.hpp>
+#include <imd_version.hpp>
 
 #include <cerrno>
 #include <chrono>
@@ -56,7 +58,6 @@
 #include <string>
 
 #include "firmware/protection/protection_config.hpp"
-#include "hal/linux/socketcan_bus.hpp"
 #include "tools/drive_monitor/cli_io.hpp"
 #include "tools/drive_monitor/identify_cli.hpp"
 #include "tools/drive_monitor/monitor.hpp"
@@ -85,7 +86,7 @@ const CLI::Validator kRepeatRate(
     "HZ");
 
 struct SendOptions {
-  std::string can;
+  BusChoice bus;
   int node = 1;
   std::string command;
   std::optional<std::string> value;
@@ -99,7 +100,7 @@ struct SendOptions {
 /// send --repeat-hz: the frames go out on CommandRepeater's schedule; between them the loop
 /// only sleeps until the next slot, the next ack deadline or a received frame, so an ack never
 /// holds up the next frame.
-int send_repeated(imd::hal::SocketCanBus& bus, const SendOptions& o,
+int send_repeated(LiveBus& bus, const SendOptions& o,
                   const imd::firmware::protocol::Command& command, uint8_t counter) {
   const imd::monitor::RepeatPlan& plan = *o.repeat;
   // Slower than the watchdog is allowed (a test may want it), but worth a word, except for the
@@ -124,8 +125,8 @@ int send_repeated(imd::hal::SocketCanBus& bus, const SendOptions& o,
     while (bus.try_receive(frame)) repeater.receive(Clock::now(), frame);
     const Clock::time_point now = Clock::now();
     if (const auto due = repeater.frame_due(now)) repeater.sent(now, bus.try_send(*due));
-    if (bus_error.empty() && interface_lost(bus)) {
-      bus_error = o.can + ": " + std::strerror(bus.last_errno());
+    if (const auto lost = bus.lost(); bus_error.empty() && lost) {
+      bus_error = *lost;
       repeater.stop(now);
     }
     if (repeater.finished(now)) break;
@@ -153,7 +154,8 @@ int send(const SendOptions& o) {
     return fail("--enable goes with set-speed only (it starts the drive at that speed), not " +
                 o.command);
   }
-  const auto bus = imd::hal::SocketCanBus::open(o.can, error);
+  if (!o.bus.given()) return fail("send: give --can IFACE or --socketcand HOST:PORT");
+  const auto bus = LiveBus::open(o.bus, error);
   if (!bus) return fail(error);
   const auto node = static_cast<uint8_t>(o.node);
   const StopSignals stop_signals;
@@ -166,8 +168,9 @@ int send(const SendOptions& o) {
       return last.has_value();
     });
     if (!last) {
-      return fail("no heartbeat from node " + std::to_string(o.node) + " on " + o.can + " within " +
-                      seconds_text(o.wait_heartbeat_s) + " s (use --counter C to send without one)",
+      return fail("no heartbeat from node " + std::to_string(o.node) + " on " + bus->name() +
+                      " within " + seconds_text(o.wait_heartbeat_s) +
+                      " s (use --counter C to send without one)",
                   kExitNoAnswer);
     }
     counter = static_cast<uint8_t>((*last + 1) & 0x0F);
@@ -178,7 +181,8 @@ int send(const SendOptions& o) {
   const imd::hal::CanFrame frame = encoder.encode(*command);
   const auto message_id = protocol::message_of(frame.id);
   if (!bus->try_send(frame)) {
-    return fail(o.can + ": could not send (transmit queue full or interface down)", kExitNoAnswer);
+    return fail(bus->name() + ": could not send (transmit queue full or interface down)",
+                kExitNoAnswer);
   }
   const std::string sent = imd::monitor::describe_command(*command) + " to node " +
                            std::to_string(o.node) + ", counter " + std::to_string(counter);
@@ -206,7 +210,7 @@ int main(int argc, char** argv) {
   SendOptions s;
   CLI::App* send_cmd = app.add_subcommand(
       "send", "Send a command and print its ack, or repeat it (--repeat-hz, --for-s)");
-  send_cmd->add_option("--can", s.can, "CAN interface (SocketCAN), e.g. can0")->required();
+  add_bus_options(*send_cmd, s.bus);
   send_cmd->add_option("--node", s.node, "Node id of the drive")
       ->check(CLI::Range(0, imd::firmware::protocol::kMaxNodeId))
       ->required();

@@ -21,7 +21,7 @@ CLI::App* add_identify_command(CLI::App& app, IdentifyOptions& o) {
       "it first: parameters --set rated_voltage_V=... rated_current_A=... rated_frequency_Hz=... "
       "pole_pairs=...), show the progress, read back the result. The drive must be idle or "
       "unconfigured with its enable input on; Ctrl-C sends a disable, which aborts the run");
-  c->add_option("--can", o.can, "CAN interface (SocketCAN), e.g. can0")->required();
+  add_bus_options(*c, o.bus);
   c->add_option("--node", o.node, "Node id of the drive")
       ->check(CLI::Range(0, protocol::kMaxNodeId))
       ->required();
@@ -45,11 +45,12 @@ CLI::App* add_identify_command(CLI::App& app, IdentifyOptions& o) {
 
 int run_identify(const IdentifyOptions& o) {
   std::string error;
-  const auto bus = hal::SocketCanBus::open(o.can, error);
+  if (!o.bus.given()) return fail("identify: give --can IFACE or --socketcand HOST:PORT");
+  const auto bus = LiveBus::open(o.bus, error);
   if (!bus) return fail(error);
   const auto node = static_cast<uint8_t>(o.node);
   const StopSignals stop_signals;
-  const std::optional<uint8_t> counter = first_counter(*bus, node, o.can, o.wait_heartbeat_s);
+  const std::optional<uint8_t> counter = first_counter(*bus, node, bus->name(), o.wait_heartbeat_s);
   if (!counter) return kExitNoAnswer;
   ParameterSession session(*bus, node, *counter, o.wait_s);
   const protocol::Command identify{protocol::CommandKind::identify, o.rotate ? 1.0f : 0.0f};
@@ -114,7 +115,7 @@ int run_identify(const IdentifyOptions& o) {
     std::cerr << "drive_monitor: warning: the rotor did not turn in the rotating step: inertia "
                  "and friction are not measured\n";
   }
-  return read_record(session, o.node, o.can, o.motor_out);
+  return read_record(session, o.node, bus->name(), o.motor_out);
 }
 
 }  // namespace imd::monitor::cli

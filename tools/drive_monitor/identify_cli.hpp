@@ -6,10 +6,12 @@
 
 #include <string>
 
+#include "tools/drive_monitor/live_bus.hpp"
+
 namespace imd::monitor::cli {
 
 struct IdentifyOptions {
-  std::string can;
+  BusChoice bus;
   int node = 1;
   bool rotate = false;    ///< also the rotating step (the shaft must be free to turn)
   std::string motor_out;  ///< write the identified record as a motor file

@@ -15,7 +15,7 @@ namespace imd::monitor::cli {
 
 class ParameterSession {
  public:
-  ParameterSession(hal::SocketCanBus& bus, uint8_t node, uint8_t counter, double wait_s)
+  ParameterSession(LiveBus& bus, uint8_t node, uint8_t counter, double wait_s)
       : bus_(bus), node_(node), encoder_(node, counter), wait_s_(wait_s) {}
 
   std::optional<ParameterReply> access(firmware::protocol::ParameterOp op, uint8_t field,
@@ -41,7 +41,7 @@ class ParameterSession {
   hal::CanFrame encode(const firmware::protocol::Command& c) { return encoder_.encode(c); }
 
  private:
-  hal::SocketCanBus& bus_;
+  LiveBus& bus_;
   uint8_t node_;
   firmware::protocol::CommandEncoder encoder_;
   double wait_s_;
@@ -49,7 +49,7 @@ class ParameterSession {
 
 /// The alive counter a session starts from: one past the last command the drive accepted, as
 /// its heartbeat says. Without a heartbeat within `wait_s`, prints why and returns nullopt.
-std::optional<uint8_t> first_counter(hal::SocketCanBus& bus, uint8_t node, const std::string& can,
+std::optional<uint8_t> first_counter(LiveBus& bus, uint8_t node, const std::string& can,
                                      double wait_s);
 
 /// Reads every field of the record and prints it; with `motor_out`, writes the motor as a motor

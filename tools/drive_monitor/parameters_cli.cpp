@@ -37,7 +37,7 @@ std::string value_text(float value) {
 CLI::App* add_parameters_command(CLI::App& app, ParametersOptions& o) {
   CLI::App* c = app.add_subcommand("parameters",
                                    "Read the drive's motor parameters; write, save, export them");
-  c->add_option("--can", o.can, "CAN interface (SocketCAN), e.g. can0")->required();
+  add_bus_options(*c, o.bus);
   c->add_option("--node", o.node, "Node id of the drive")
       ->check(CLI::Range(0, protocol::kMaxNodeId))
       ->required();
@@ -77,11 +77,12 @@ int run_parameters(const ParametersOptions& o) {
     }
   }
   std::string error;
-  const auto bus = hal::SocketCanBus::open(o.can, error);
+  if (!o.bus.given()) return fail("parameters: give --can IFACE or --socketcand HOST:PORT");
+  const auto bus = LiveBus::open(o.bus, error);
   if (!bus) return fail(error);
   const auto node = static_cast<uint8_t>(o.node);
   const StopSignals stop_signals;
-  const std::optional<uint8_t> counter = first_counter(*bus, node, o.can, o.wait_heartbeat_s);
+  const std::optional<uint8_t> counter = first_counter(*bus, node, bus->name(), o.wait_heartbeat_s);
   if (!counter) return kExitNoAnswer;
   ParameterSession session(*bus, node, *counter, o.wait_s);
 
@@ -109,11 +110,11 @@ int run_parameters(const ParametersOptions& o) {
     std::cout << "save: " << status_name(reply->status) << '\n';
     if (reply->status != ParameterStatus::ok) status = kExitRejected;
   }
-  const int read_status = read_record(session, o.node, o.can, o.motor_out);
+  const int read_status = read_record(session, o.node, bus->name(), o.motor_out);
   return read_status != 0 ? read_status : status;
 }
 
-std::optional<uint8_t> first_counter(hal::SocketCanBus& bus, uint8_t node, const std::string& can,
+std::optional<uint8_t> first_counter(LiveBus& bus, uint8_t node, const std::string& can,
                                      double wait_s) {
   std::optional<uint8_t> last;
   receive_until(bus, wait_s, [&](const hal::CanFrame& f) {

@@ -5,12 +5,14 @@
 #include <CLI/CLI.hpp>
 
 #include <string>
+
 #include <vector>
+#include "tools/drive_monitor/live_bus.hpp"
 
 namespace imd::monitor::cli {
 
 struct ParametersOptions {
-  std::string can;
+  BusChoice bus;
   int node = 1;
   std::vector<std::string> sets;  ///< KEY=VALUE, in order
   std::string motor_file;         ///< every field from this motor file

@@ -48,7 +48,7 @@ void add_heartbeat(std::string& out, const DriveStatus& status) {
   add(out, "limited", enum_text(signal(MessageId::heartbeat, "limited"), h.limited));
   add(out, "stop",
       fmt::format("{}, brake {}", enum_text(signal(MessageId::heartbeat, "stop"), h.stop),
-                  h.brake ? "engaged" : "released"));
+                  h.brake ? "engaged" : "released or none fitted"));
   add(out, "reset cause", enum_text(signal(MessageId::heartbeat, "reset_cause"), h.reset_cause));
   add(out, "commands",
       fmt::format("{} rejected (wraps at 64), {} command frames seen", h.rejected_commands,

@@ -10,7 +10,6 @@
 #include <optional>
 
 #include "firmware/protocol/messages.hpp"
-#include "hal/linux/socketcan_bus.hpp"
 #include "tools/can_log/candump_log.hpp"
 #include "tools/drive_monitor/capture_report.hpp"
 #include "tools/drive_monitor/cli_io.hpp"
@@ -48,12 +47,6 @@ class CsvOutput {
   std::ofstream file_;
   std::ostream* stream_ = nullptr;
 };
-
-BusInfo bus_info(const hal::SocketCanBus& bus) {
-  const hal::CanErrorState& e = bus.errors();
-  return {e.error_frames, e.bus_off_events, e.bus_off,
-          hal::describe_error_class(e.last_error_class), bus.unsupported_frames()};
-}
 
 /// Redraws the table in place: cursor home, each line cleared to its end, the rest erased.
 void redraw(const std::string& table) {
@@ -102,7 +95,7 @@ int watch_log(const WatchOptions& o) {
 
 int watch_live(const WatchOptions& o) {
   std::string error;
-  const auto bus = hal::SocketCanBus::open(o.can, error);
+  const auto bus = LiveBus::open(o.bus, error);
   if (!bus) return fail(error);
   CsvOutput csv;
   if (!csv.open(o.csv, error)) return fail(error);
@@ -123,28 +116,30 @@ int watch_live(const WatchOptions& o) {
       const double t_s = std::chrono::duration<double>(Clock::now() - start).count();
       csv.write(monitor.feed(t_s, frame));
     }
-    if (interface_lost(*bus)) {
-      return fail(o.can + ": receive failed: " + std::strerror(bus->last_errno()));
-    }
+    if (const auto lost = bus->lost()) return fail(*lost);
     if (Clock::now() >= next_refresh) {
       next_refresh = Clock::now() + kRefreshPeriod;
-      const BusInfo info = bus_info(*bus);
-      if (live_table) redraw(render_table(monitor.status(), monitor.node_id(), o.can, &info));
+      const std::optional<BusInfo> info = bus->info();
+      if (live_table) {
+        redraw(render_table(monitor.status(), monitor.node_id(), bus->name(),
+                            info ? &*info : nullptr));
+      }
     }
   }
-  const BusInfo info = bus_info(*bus);
-  const std::string table = render_table(monitor.status(), monitor.node_id(), o.can, &info);
+  const std::optional<BusInfo> info = bus->info();
+  const std::string table =
+      render_table(monitor.status(), monitor.node_id(), bus->name(), info ? &*info : nullptr);
   if (live_table) {
     redraw(table);
   } else if (!o.no_table) {
     std::cout << table;
   }
   if (!csv.good()) return fail(o.csv + ": write error", kExitOutputError);
-  // The interface counts what it drops; a classic socket is never given CAN FD frames.
+  // The bus counts what it drops; a classic socket is never given CAN FD frames.
   SkippedFrames skipped;
-  skipped.error = info.error_frames;
-  skipped.unsupported = info.unsupported_frames;
-  return finish_watch(monitor, skipped, o.can, true);
+  skipped.error = info ? info->error_frames : 0;
+  skipped.unsupported = bus->unsupported_frames();
+  return finish_watch(monitor, skipped, bus->name(), true);
 }
 
 }  // namespace
@@ -157,8 +152,10 @@ CLI::App* add_watch_command(CLI::App& app, WatchOptions& o) {
       "Exit codes: 0 success, 1 writing the CSV failed during the watch (disk full), 2 bad "
       "input (command line, interface, a CSV that cannot be created, malformed log line), 4 no "
       "frame from the node (is --node right?).");
-  auto* can = watch->add_option("--can", o.can, "CAN interface (SocketCAN), e.g. can0");
-  watch->add_option("--log", o.log, "candump -L log file instead of an interface")->excludes(can);
+  CLI::Option* can = add_bus_options(*watch, o.bus);
+  watch->add_option("--log", o.log, "candump -L log file instead of a live bus")
+      ->excludes(can)
+      ->excludes("--socketcand");
   watch->add_option("--node", o.node, "Node id of the drive")
       ->check(CLI::Range(0, firmware::protocol::kMaxNodeId))
       ->capture_default_str();
@@ -172,7 +169,9 @@ CLI::App* add_watch_command(CLI::App& app, WatchOptions& o) {
 }
 
 int run_watch(const WatchOptions& o) {
-  if (o.can.empty() && o.log.empty()) return fail("watch: give --can IFACE or --log FILE");
+  if (!o.bus.given() && o.log.empty()) {
+    return fail("watch: give --can IFACE, --socketcand HOST:PORT or --log FILE");
+  }
   return o.log.empty() ? watch_live(o) : watch_log(o);
 }
 

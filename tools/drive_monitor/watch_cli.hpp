@@ -1,5 +1,5 @@
 #pragma once
-/// drive_monitor watch: decodes one node's frames from a CAN interface or a candump -L log into
+/// drive_monitor watch: decodes one node's frames from a CAN interface, a socketcand server or a candump -L log into
 /// the status table and a telemetry CSV; skips and counts everything else a shared bus carries
 /// and ends with a summary line (capture_report.hpp). Exit codes: 0 success, kExitOutputError
 /// writing the CSV failed during the watch (disk full), kExitBadInput bad input before anything
@@ -9,10 +9,12 @@
 
 #include <string>
 
+#include "tools/drive_monitor/live_bus.hpp"
+
 namespace imd::monitor::cli {
 
 struct WatchOptions {
-  std::string can;
+  BusChoice bus;
   std::string log;
   std::string csv;
   int node = 1;

@@ -1,0 +1,229 @@
+// SocketcandClient against the project's own SocketcandServer on loopback TCP (the handshake,
+// frames both ways, one client at a time, the connection lost when the server goes, the error
+// when nothing listens), against a raw server that writes one byte at a time (partial reads),
+// and the client's side of the text: server messages parsed, `< send ... >` formatted.
+#include <arpa/inet.h>
+#include <gtest/gtest.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <string>
+#include <thread>
+
+#include "hal/linux/socketcand_client.hpp"
+#include "hal/linux/socketcand_server.hpp"
+
+namespace imd::hal {
+namespace {
+
+using namespace std::chrono_literals;
+constexpr auto kWait = 5s;  // generous: ctest runs tests in parallel on a small machine
+
+uint16_t port_of(const SocketcandServer& server) {
+  const std::string& address = server.address();
+  return static_cast<uint16_t>(std::stoi(address.substr(address.rfind(':') + 1)));
+}
+
+template <typename Bus>
+bool receive_within(Bus& bus, CanFrame& frame) {
+  const auto deadline = std::chrono::steady_clock::now() + kWait;
+  while (std::chrono::steady_clock::now() < deadline) {
+    if (bus.try_receive(frame)) return true;
+    std::this_thread::sleep_for(1ms);
+  }
+  return false;
+}
+
+CanFrame frame_of(uint16_t id, std::initializer_list<uint8_t> bytes) {
+  CanFrame f;
+  f.id = id;
+  for (const uint8_t b : bytes) f.data[f.length++] = b;
+  return f;
+}
+
+TEST(SocketcandClient, ExchangesFramesWithTheServer) {
+  std::string error;
+  const auto server = SocketcandServer::open("127.0.0.1", 0, error);
+  ASSERT_TRUE(server) << error;
+  const auto client = SocketcandClient::open("127.0.0.1", port_of(*server), error);
+  ASSERT_TRUE(client) << error;
+
+  ASSERT_TRUE(client->try_send(frame_of(0x021, {0x01, 0xAB, 0x00})));
+  CanFrame got;
+  ASSERT_TRUE(receive_within(*server, got));
+  EXPECT_EQ(got.id, 0x021);
+  ASSERT_EQ(got.length, 3);
+  EXPECT_EQ(got.data[1], 0xAB);
+
+  // The server sends only once the client is in raw mode; open() returns after that.
+  ASSERT_TRUE(server->try_send(frame_of(0x701, {})));
+  ASSERT_TRUE(server->try_send(frame_of(0x181, {1, 2, 3, 4, 5, 6, 7, 8})));
+  ASSERT_TRUE(receive_within(*client, got));
+  EXPECT_EQ(got.id, 0x701);
+  EXPECT_EQ(got.length, 0);
+  ASSERT_TRUE(receive_within(*client, got));
+  EXPECT_EQ(got.id, 0x181);
+  ASSERT_EQ(got.length, 8);
+  EXPECT_EQ(got.data[7], 8);
+  EXPECT_TRUE(client->lost().empty());
+  EXPECT_EQ(client->server_errors(), 0u);
+}
+
+TEST(SocketcandClient, RefusesInvalidFrames) {
+  std::string error;
+  const auto server = SocketcandServer::open("127.0.0.1", 0, error);
+  ASSERT_TRUE(server) << error;
+  const auto client = SocketcandClient::open("127.0.0.1", port_of(*server), error);
+  ASSERT_TRUE(client) << error;
+  EXPECT_FALSE(client->try_send(frame_of(0x800, {})));
+  CanFrame long_frame;
+  long_frame.length = 9;
+  EXPECT_FALSE(client->try_send(long_frame));
+}
+
+TEST(SocketcandClient, SaysWhatToStartWhenNothingListens) {
+  std::string error;
+  uint16_t port = 0;
+  {
+    const auto server = SocketcandServer::open("127.0.0.1", 0, error);
+    ASSERT_TRUE(server) << error;
+    port = port_of(*server);
+  }  // closed: nothing listens on that port now
+  EXPECT_FALSE(SocketcandClient::open("127.0.0.1", port, error));
+  const std::string at = "127.0.0.1:" + std::to_string(port);
+  EXPECT_EQ(error,
+            "no socketcand server at " + at +
+                ": connection refused; start drive_hil --can socketcand:" + std::to_string(port));
+}
+
+TEST(SocketcandClient, ASecondClientIsToldTheServerIsBusy) {
+  std::string error;
+  const auto server = SocketcandServer::open("127.0.0.1", 0, error);
+  ASSERT_TRUE(server) << error;
+  const auto first = SocketcandClient::open("127.0.0.1", port_of(*server), error);
+  ASSERT_TRUE(first) << error;
+  EXPECT_FALSE(SocketcandClient::open("127.0.0.1", port_of(*server), error));
+  EXPECT_NE(error.find("busy: another client is connected"), std::string::npos) << error;
+}
+
+TEST(SocketcandClient, KnowsWhenTheServerHasGone) {
+  std::string error;
+  auto server = SocketcandServer::open("127.0.0.1", 0, error);
+  ASSERT_TRUE(server) << error;
+  const auto client = SocketcandClient::open("127.0.0.1", port_of(*server), error);
+  ASSERT_TRUE(client) << error;
+  server.reset();
+  CanFrame got;
+  const auto deadline = std::chrono::steady_clock::now() + kWait;
+  while (client->lost().empty() && std::chrono::steady_clock::now() < deadline) {
+    EXPECT_FALSE(client->try_receive(got));
+    std::this_thread::sleep_for(1ms);
+  }
+  EXPECT_EQ(client->lost(), "the server closed the connection (drive_hil stopped?)");
+  EXPECT_FALSE(client->try_send(frame_of(0x021, {})));
+}
+
+/// A listening socket whose one client is written `text` one byte per send, with pauses, so
+/// that every message arrives cut into pieces.
+struct TricklingServer {
+  int listen_fd = -1;
+  uint16_t port = 0;
+  std::thread thread;
+  explicit TricklingServer(std::string text) {
+    listen_fd = ::socket(AF_INET, SOCK_STREAM, 0);
+    sockaddr_in address{};
+    address.sin_family = AF_INET;
+    address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    socklen_t length = sizeof address;
+    EXPECT_EQ(::bind(listen_fd, reinterpret_cast<sockaddr*>(&address), length), 0);
+    EXPECT_EQ(::listen(listen_fd, 1), 0);
+    ::getsockname(listen_fd, reinterpret_cast<sockaddr*>(&address), &length);
+    port = ntohs(address.sin_port);
+    thread = std::thread([this, text] {
+      const int fd = ::accept(listen_fd, nullptr, nullptr);
+      char answer[64];
+      for (const char c : text) {
+        if (c == '\x01') {  // the handshake's turn: wait for the client's message
+          EXPECT_GT(::recv(fd, answer, sizeof answer, 0), 0);
+          continue;
+        }
+        ::send(fd, &c, 1, MSG_NOSIGNAL);
+        std::this_thread::sleep_for(100us);
+      }
+      std::this_thread::sleep_for(200ms);  // the client reads before the close
+      ::close(fd);
+    });
+  }
+  ~TricklingServer() {
+    thread.join();
+    ::close(listen_fd);
+  }
+};
+
+TEST(SocketcandClient, ReadsMessagesCutAnywhere) {
+  // `< ok >` and the first frame are written together: the frame must not be lost.
+  TricklingServer server("< hi >\x01< ok >\x01< ok >< frame 21 1.000001 0102 >  < frame 7FF 2.5 >");
+  std::string error;
+  const auto client = SocketcandClient::open("127.0.0.1", server.port, error);
+  ASSERT_TRUE(client) << error;
+  CanFrame got;
+  ASSERT_TRUE(receive_within(*client, got));
+  EXPECT_EQ(got.id, 0x021);
+  ASSERT_EQ(got.length, 2);
+  EXPECT_EQ(got.data[1], 0x02);
+  ASSERT_TRUE(receive_within(*client, got));
+  EXPECT_EQ(got.id, 0x7FF);
+  EXPECT_EQ(got.length, 0);
+}
+
+TEST(SocketcandText, ParsesWhatAServerSays) {
+  using Kind = SocketcandReply::Kind;
+  EXPECT_EQ(parse_socketcand_reply("hi").kind, Kind::hi);
+  EXPECT_EQ(parse_socketcand_reply("ok").kind, Kind::ok);
+  const SocketcandReply error = parse_socketcand_reply("error busy");
+  EXPECT_EQ(error.kind, Kind::error);
+  EXPECT_EQ(error.text, "busy");
+  const SocketcandReply frame = parse_socketcand_reply("frame 181 1700000000.123456 0A0b");
+  ASSERT_EQ(frame.kind, Kind::frame);
+  EXPECT_EQ(frame.frame.id, 0x181);
+  ASSERT_EQ(frame.frame.length, 2);
+  EXPECT_EQ(frame.frame.data[0], 0x0A);
+  EXPECT_EQ(frame.frame.data[1], 0x0B);
+  EXPECT_EQ(parse_socketcand_reply("frame 12345678 1.0 00").kind, Kind::other);  // 29-bit
+  EXPECT_EQ(parse_socketcand_reply("frame 800 1.0").kind, Kind::bad);
+  EXPECT_EQ(parse_socketcand_reply("frame 1 1.0 ABC").kind, Kind::bad);
+  EXPECT_EQ(parse_socketcand_reply("frame 1 1.0 000102030405060708").kind, Kind::bad);
+  EXPECT_EQ(parse_socketcand_reply("frame 1 1.0 0G").kind, Kind::bad);
+  EXPECT_EQ(parse_socketcand_reply("frame 1").kind, Kind::bad);
+  EXPECT_EQ(parse_socketcand_reply("hello").kind, Kind::other);
+}
+
+TEST(SocketcandText, FormatsASendTheServerAccepts) {
+  const CanFrame frame = frame_of(0x21, {0x01, 0xAB});
+  const std::string text = format_socketcand_send(frame);
+  EXPECT_EQ(text, "< send 021 2 01 AB >");
+  const SocketcandCommand back = parse_socketcand(text.substr(1, text.size() - 2));
+  ASSERT_EQ(back.kind, SocketcandCommand::Kind::send);
+  EXPECT_EQ(back.frame.id, 0x21);
+  EXPECT_EQ(back.frame.data[1], 0xAB);
+  EXPECT_EQ(format_socketcand_send(frame_of(0x7FF, {})), "< send 7FF 0 >");
+}
+
+TEST(SocketcandAddress, TakesHostColonPort) {
+  std::string host, error;
+  uint16_t port = 0;
+  ASSERT_TRUE(parse_socketcand_address("127.0.0.1:29536", host, port, error));
+  EXPECT_EQ(host, "127.0.0.1");
+  EXPECT_EQ(port, 29536);
+  ASSERT_TRUE(parse_socketcand_address("[::1]:7", host, port, error));
+  EXPECT_EQ(host, "::1");
+  for (const char* bad : {"29536", "host:", ":5", "h:0", "h:70000", "h:12x"}) {
+    EXPECT_FALSE(parse_socketcand_address(bad, host, port, error)) << bad;
+    EXPECT_EQ(error, std::string("--socketcand ") + bad + ": give HOST:PORT, e.g. 127.0.0.1:29536");
+  }
+}
+
+}  // namespace
+}  // namespace imd::hal
