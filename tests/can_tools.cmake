@@ -26,8 +26,17 @@ if(TARGET drive_monitor)
   endfunction()
   imd_monitor_test(drive_monitor_help 0 "watch" --help)
   imd_monitor_test(drive_monitor_no_subcommand 2 "A subcommand is required")
-  imd_monitor_test(drive_monitor_no_source 2 "drive_monitor: watch: give --can IFACE or --log FILE"
+  imd_monitor_test(drive_monitor_no_source 2
+                   "drive_monitor: watch: give --can IFACE, --socketcand HOST:PORT or --log FILE"
                    watch)
+  imd_monitor_test(drive_monitor_send_no_bus 2
+                   "drive_monitor: send: give --can IFACE or --socketcand HOST:PORT"
+                   send --node 1 enable)
+  imd_monitor_test(drive_monitor_bad_socketcand_address 2
+                   "drive_monitor: --socketcand 29536: give HOST:PORT, e.g. 127.0.0.1:29536"
+                   parameters --socketcand 29536 --node 1)
+  imd_monitor_test(drive_monitor_can_and_socketcand 2 "--can excludes --socketcand"
+                   identify --can vcan0 --socketcand 127.0.0.1:29536 --node 1)
   imd_monitor_test(drive_monitor_bad_interface 2 "${NO_CAN_IFACE}" watch --can vcan9)
   imd_monitor_test(drive_monitor_send_bad_interface 2 "${NO_CAN_IFACE}"
                    send --can vcan9 --node 1 enable)
