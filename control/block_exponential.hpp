@@ -33,6 +33,7 @@
 #include <Eigen/Core>
 #include <cmath>
 
+#include "control/block_squaring.hpp"
 namespace imd::control {
 
 template <typename T>
@@ -92,17 +93,7 @@ BlockExponential<T> block_exponential(const Eigen::Matrix<T, 3, 3>& x, T g) noex
     r.w += c;
   }
 
-  // Squaring: [E Y Z; 0 eI wI; 0 0 I]^2 = [E^2, EY + eY, EZ + wY + Z; 0, e^2 I, (e+1)w I; ...].
-  for (int k = 0; k < squarings; ++k) {
-    const Matrix3 e_x = r.e_x * r.e_x;
-    const Matrix3 y = r.e_x * r.y + r.e_g * r.y;
-    const Matrix3 z = r.e_x * r.z + r.w * r.y + r.z;
-    r.w = (r.e_g + T(1)) * r.w;
-    r.e_g = r.e_g * r.e_g;
-    r.e_x = e_x;
-    r.y = y;
-    r.z = z;
-  }
+  square_blocks(r, squarings);
   return r;
 }
 

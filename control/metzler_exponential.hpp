@@ -43,6 +43,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "control/block_squaring.hpp"
 namespace imd::control {
 
 /// The blocks of exp(B) that are kept, for an N x N block X (N = 3 for the electrical models,
@@ -138,17 +139,7 @@ MetzlerExponential<T, N> metzler_block_exponential(const Eigen::Matrix<T, N, N>&
   r.e_g *= unshift;
   r.w *= unshift;
 
-  // Squaring: [E Y Z; 0 e w; 0 0 I]^2 = [E^2, EY + eY, EZ + wY + Z; 0, e^2, (e + 1) w; 0 0 I].
-  for (int k = 0; k < squarings; ++k) {
-    const Matrix e_x = r.e_x * r.e_x;
-    const Matrix y = r.e_x * r.y + r.e_g * r.y;
-    const Matrix z = r.e_x * r.z + r.w * r.y + r.z;
-    r.w = (r.e_g + T(1)) * r.w;
-    r.e_g = r.e_g * r.e_g;
-    r.e_x = e_x;
-    r.y = y;
-    r.z = z;
-  }
+  square_blocks(r, squarings);
   return r;
 }
 
