@@ -1,6 +1,7 @@
 """The command line: --version, clear errors for bad flags and values, and send / param /
 identify against the fake drive (in-process: the virtual bus lives in this process)."""
 import importlib.util
+import os
 import re
 import shutil
 import subprocess
@@ -85,6 +86,10 @@ def test_watch_of_a_silent_node_warns_and_exits_4(source_dir, capsys):
     (["watch", "--log", "/nonexistent.log"], "/nonexistent.log: cannot open file"),
     (["plot", "--log", "x.log", "--duration-s", "-1"], "--duration-s: must be a time"),
     (["send", "--interface", "virtual", "enable"], "--interface virtual needs --channel"),
+    (["plot", "--log", "x.log", "--save", "out.txt"], "--save out.txt: the file name must end in .png"),
+    (["plot", "--log", "x.log", "--save", "/nonexistent/p.png"], "no directory /nonexistent"),
+    (["watch", "--log", "../../tests/data/can/shared_bus.log", "--csv", "/nonexistent/x.csv"],
+     "--csv /nonexistent/x.csv: cannot write the file"),
 ])
 def test_bad_input_exits_2_and_says_why(args, message):
     result = cli(*args)
@@ -132,3 +137,10 @@ def test_watch_warns_of_a_drive_on_another_protocol(tmp_path, capsys):
     assert (f"imdrive: warning: node 1 speaks protocol {table.PROTOCOL_VERSION + 1} (firmware "
             f"0.2.0+ga2e14617), this client protocol {table.PROTOCOL_VERSION}"
             in capsys.readouterr().err)
+
+
+def test_a_live_plot_without_a_display_says_to_save():
+    env = {k: v for k, v in os.environ.items() if k not in ("DISPLAY", "WAYLAND_DISPLAY")}
+    result = subprocess.run([sys.executable, "-B", "-m", "imdrive", "plot", "--log", "x.log"],
+                            capture_output=True, text=True, cwd=PACKAGE_DIR, env=env)
+    assert result.returncode == 2 and "give --save FILE.png" in result.stderr, result.stderr

@@ -6,6 +6,7 @@ answer in time (watch: no frame at all from the node).
 """
 import argparse
 import math
+import os
 import sys
 import time
 
@@ -144,7 +145,7 @@ def run_watch(args, out):
     csv = None
     fields = list(TelemetrySample.__dataclass_fields__)
     if args.csv:
-        csv = sys.stdout if args.csv == "-" else open(args.csv, "w")
+        csv = sys.stdout if args.csv == "-" else _open_output(args.csv, "--csv")
         csv.write(",".join(fields) + "\n")
     end = time.monotonic() + args.duration_s if args.duration_s else math.inf
     samples = 0
@@ -247,8 +248,31 @@ def run_identify(drive, args, out):
     return 0
 
 
+def _open_output(path, flag):
+    """A file to write, or a UsageError naming the flag and why it cannot be written."""
+    try:
+        return open(path, "w")
+    except OSError as error:
+        raise UsageError(f"{flag} {path}: cannot write the file ({error.strerror})") from None
+
+
+def _check_plot_target(args):
+    """Before any frame is read: a --save name matplotlib writes as PNG in a directory that
+    exists, or a display for the live window."""
+    if args.save:
+        if not args.save.lower().endswith(".png"):
+            raise UsageError(f"--save {args.save}: the file name must end in .png")
+        folder = os.path.dirname(os.path.abspath(args.save))
+        if not os.path.isdir(folder):
+            raise UsageError(f"--save {args.save}: no directory {folder}")
+    elif not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")):
+        raise UsageError("no display for a live window (DISPLAY is not set): "
+                         "give --save FILE.png")
+
+
 def run_plot(args, out):
     from . import plot
+    _check_plot_target(args)
     bus = open_bus(args)
     if args.log:
         monitor = Monitor(args.node)
