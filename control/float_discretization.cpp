@@ -42,8 +42,8 @@ VoltageFedFloatGenerators voltage_fed_float_generators(const MotorParameters& mo
       0.0f, -alpha * delta, alpha * lm * delta,                     //
       0.0f, alpha * beta * delta, -gamma * delta;
   g.friction = -float(motor.friction_Nms) / j * delta;
-  g.mu_per_kgm2 = float(kClarkeTorqueFactor) * lm * float(motor.pole_pairs) / (j * lr);
-  g.inv_J_per_kgm2 = 1.0f / j;
+  g.mu_1_per_kgm2 = float(kClarkeTorqueFactor) * lm * float(motor.pole_pairs) / (j * lr);
+  g.inv_J_1_per_kgm2 = 1.0f / j;
   g.delta_s = delta;
   return g;
 }
@@ -66,7 +66,7 @@ VoltageFedCoefficients discretize_voltage_fed<float>(const MotorParameters& moto
   c.b2 = e3(1, 2);
   const MetzlerExponential<float, 3> van_loan =
       metzler_block_exponential<float, 3>(g.compound, g.friction);
-  const float y_scale = g.mu_per_kgm2 * delta;
+  const float y_scale = g.mu_1_per_kgm2 * delta;
   const float z_scale = y_scale * delta;
   c.eta1 = y_scale * van_loan.y(0, 0);
   c.eta2 = -y_scale * van_loan.y(0, 1);
@@ -81,8 +81,8 @@ VoltageFedCoefficients discretize_voltage_fed<float>(const MotorParameters& moto
   c.omega_decay = mech.e_g;
   c.omega_decay_minus_one = std::expm1(g.friction);
   c.omega_to_theta_s = delta * mech.y(0, 0);
-  c.load_to_omega = -(delta * g.inv_J_per_kgm2) * mech.y(0, 0);
-  c.load_to_theta = -(delta * delta * g.inv_J_per_kgm2) * mech.z(0, 0);
+  c.load_to_omega = -(delta * g.inv_J_1_per_kgm2) * mech.y(0, 0);
+  c.load_to_theta = -(delta * delta * g.inv_J_1_per_kgm2) * mech.z(0, 0);
   return c;
 }
 

@@ -69,8 +69,8 @@ struct VoltageFedFloatGenerators {
   Eigen::Matrix3f axis = Eigen::Matrix3f::Zero();
   Eigen::Matrix3f compound = Eigen::Matrix3f::Zero();
   float friction = 0.0f;
-  float mu_per_kgm2 = 0.0f;     ///< mu of paper 000
-  float inv_J_per_kgm2 = 0.0f;  ///< 1 / J
+  float mu_1_per_kgm2 = 0.0f;     ///< mu = 3/2 p Lm / (J Lr) of paper 000, 1/(kg m^2)
+  float inv_J_1_per_kgm2 = 0.0f;  ///< 1 / J, 1/(kg m^2)
   float delta_s = 0.0f;         ///< sample period
 };
 VoltageFedFloatGenerators voltage_fed_float_generators(const MotorParameters& motor,

@@ -50,6 +50,9 @@ Drive<T>::Drive(const std::optional<MotorRecord>& record, const DriveConfig& con
   protection_.set_clock(clock_Hz_);
   hw_.pwm.disable();
   supervisor_.status().reset_cause = static_cast<uint8_t>(peripherals.reset_cause);
+  // A fitted brake holds from power-up (its line is not driven): the first heartbeat, published
+  // before the end of the first tick sets the flag, must say so.
+  supervisor_.status().brake_engaged = config.brake_output_line >= 0;
 }
 
 template <typename T>

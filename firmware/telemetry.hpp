@@ -32,7 +32,9 @@ struct DriveStatus {
   Limitation limited = Limitation::none;  ///< a limit holds the running drive back
   StopCategory stop = StopCategory::none;  ///< how the latched fault stops the drive
   /// The holding brake engaged: a brake line is configured and not driven (false without one).
-  bool brake_engaged = true;
+  /// False here so that a drive without a brake line never reports one; a drive with one sets
+  /// it true at construction, before its first heartbeat (its line starts undriven).
+  bool brake_engaged = false;
   uint8_t reset_cause = 0;                 ///< why the board last started (hal::ResetCause)
   // The last commissioning run: its step (kIdentifyStepValues; 6 none yet), progress and end.
   uint8_t identify_step = 6;

@@ -8,11 +8,12 @@
 ///   M = [ -alpha + j p w     alpha Lm ]
 ///       [ alpha beta - j p beta w   -gamma ],
 /// whose eigenvalues are bounded by rho = alpha + gamma + p |w| (checked numerically for the
-/// test motors over +-3000 rad/s: |lambda| <= 0.99 rho). The method's local error on such a mode
-/// is about |lambda h|^7 / 7! (the first term of e^z it misses), so with rho h <= 0.05 it is below
-/// 2e-13 of the state per step, and the mode damps what it accumulates. RK4 at 10 us has
-/// |lambda h| < 0.02 for every motor of the tests (0.75 to 37 kW, up to twice their speed) and a
-/// local error of |lambda h|^5 / 5! < 3e-11. tests/hal_sim/test_plant_integrator.cpp measures
+/// test motors over +-3000 rad/s: |lambda| <= 0.99 rho). The method's stability polynomial
+/// matches e^z up to z^6; its z^7 coefficient is -1/2160 where e^z has 1/5040, so the local error
+/// on such a mode is about |lambda h|^7 (1/2160 + 1/5040) = |lambda h|^7 / 1512: with
+/// rho h <= 0.05 it is below 5.2e-13 of the state per step, and the mode damps what it
+/// accumulates. RK4 at 10 us has |lambda h| < 0.02 for every motor of the tests (0.75 to
+/// 37 kW, up to twice their speed) and a local error of |lambda h|^5 / 5! < 3e-11. tests/hal_sim/test_plant_integrator.cpp measures
 /// both against RK4 at 1 us and requires the two to agree within 1e-9 of each state's scale.
 ///
 /// The sixth-order method is used only where the right-hand side is smooth over the period:

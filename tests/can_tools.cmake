@@ -33,8 +33,8 @@ if(TARGET drive_monitor)
                    "drive_monitor: send: give --can IFACE or --socketcand HOST:PORT"
                    send --node 1 enable)
   imd_monitor_test(drive_monitor_bad_socketcand_address 2
-                   "drive_monitor: --socketcand 29536: give HOST:PORT, e.g. 127.0.0.1:29536"
-                   parameters --socketcand 29536 --node 1)
+                   "drive_monitor: --socketcand host:0: expected PORT, HOST:PORT or \\[V6\\]:PORT with a port in 1..65535"
+                   parameters --socketcand host:0 --node 1)
   imd_monitor_test(drive_monitor_can_and_socketcand 2 "--can excludes --socketcand"
                    identify --can vcan0 --socketcand 127.0.0.1:29536 --node 1)
   imd_monitor_test(drive_monitor_bad_interface 2 "${NO_CAN_IFACE}" watch --can vcan9)

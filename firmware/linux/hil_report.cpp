@@ -65,7 +65,8 @@ nlohmann::json report_json(const HilRunFacts& f) {
                               {"clients_refused", f.socketcand->clients_refused},
                               {"dropped_no_client", f.socketcand->dropped_no_client},
                               {"client_errors", f.socketcand->client_errors},
-                              {"filtered", f.socketcand->filtered}};
+                              {"filtered", f.socketcand->filtered},
+                              {"clients_dropped", f.socketcand->clients_dropped}};
   }
   return j;
 }

@@ -16,14 +16,14 @@
 namespace imd::hal {
 namespace {
 
-constexpr int kMaxReadsPerReceive = 16;  // bounds try_receive under a flood of skipped text
+// Reads after the first that one try_receive makes: bounds it under a flood of skipped text.
+constexpr int kMaxReadsPerReceive = 16;
 
 int64_t now_ms() {
   return std::chrono::duration_cast<std::chrono::milliseconds>(
              std::chrono::steady_clock::now().time_since_epoch())
       .count();
 }
-
 
 /// Non-blocking connect, waited for up to `timeout_ms`; the socket, or -1 and errno.
 int connect_within(const sockaddr_storage& address, socklen_t length, int timeout_ms) {
@@ -50,16 +50,20 @@ int connect_within(const sockaddr_storage& address, socklen_t length, int timeou
 
 bool parse_socketcand_address(const std::string& text, std::string& host, uint16_t& port,
                               std::string& error) {
+  // The same rules as imdrive's parse_host_port (tools/python/imdrive/bus_open.py).
   const std::size_t colon = text.rfind(':');
-  const std::string port_text = colon == std::string::npos ? "" : text.substr(colon + 1);
-  host = colon == std::string::npos ? "" : text.substr(0, colon);
+  const std::string port_text = colon == std::string::npos ? text : text.substr(colon + 1);
+  host = colon == std::string::npos ? std::string(kDefaultSocketcandHost) : text.substr(0, colon);
   if (host.size() >= 2 && host.front() == '[' && host.back() == ']') {
     host = host.substr(1, host.size() - 2);
   }
-  char* end = nullptr;
-  const long value = port_text.empty() ? -1 : std::strtol(port_text.c_str(), &end, 10);
-  if (host.empty() || value < 1 || value > 65535 || *end != '\0') {
-    error = "--socketcand " + text + ": give HOST:PORT, e.g. 127.0.0.1:29536";
+  const bool digits = !port_text.empty() && port_text.size() <= 5 &&
+                      port_text.find_first_not_of("0123456789") == std::string::npos;
+  const long value = digits ? std::strtol(port_text.c_str(), nullptr, 10) : 0;
+  if (host.empty() || value < 1 || value > 65535) {
+    error = "--socketcand " + text +
+            ": expected PORT, HOST:PORT or [V6]:PORT with a port in 1..65535, e.g. "
+            "127.0.0.1:29536";
     return false;
   }
   port = static_cast<uint16_t>(value);
@@ -172,6 +176,10 @@ bool SocketcandClient::read_some() noexcept {
   return false;
 }
 
+short SocketcandClient::poll_events() const noexcept {
+  return static_cast<short>(POLLIN | (pending_.empty() || !lost_.empty() ? 0 : POLLOUT));
+}
+
 bool SocketcandClient::try_send(const CanFrame& frame) noexcept {
   if (frame.id > 0x7FF || frame.length > 8 || !flush()) return false;
   if (pending_.size() > kMaxPendingOutput_bytes) return false;
@@ -181,10 +189,12 @@ bool SocketcandClient::try_send(const CanFrame& frame) noexcept {
 
 bool SocketcandClient::try_receive(CanFrame& frame) noexcept {
   flush();  // what an earlier try_send left over
-  for (int reads = 0; reads <= kMaxReadsPerReceive;) {
+  // After the last read, what it brought is still parsed: a frame it completed must not wait
+  // in the reader while the caller sleeps on a socket with nothing more to come.
+  for (int reads = 0;;) {
     const std::optional<SocketcandPiece> piece = reader_.next();
     if (!piece) {
-      if (!read_some()) return false;
+      if (reads > kMaxReadsPerReceive || !read_some()) return false;
       ++reads;
       continue;
     }
@@ -206,7 +216,6 @@ bool SocketcandClient::try_receive(CanFrame& frame) noexcept {
         break;
     }
   }
-  return false;
 }
 
 }  // namespace imd::hal

@@ -15,8 +15,11 @@
 
 namespace imd::hal {
 
-/// "HOST:PORT" ("[::1]:PORT" for IPv6) -> host and port. False and `error` naming `text` when
-/// it is not one.
+/// Where --socketcand PORT connects: the drive on this machine.
+inline constexpr const char* kDefaultSocketcandHost = "127.0.0.1";
+
+/// "PORT" (host kDefaultSocketcandHost), "HOST:PORT" or "[V6]:PORT" -> host and port, by the
+/// same rules as imdrive's --socketcand. False and `error` naming `text` when it is none.
 bool parse_socketcand_address(const std::string& text, std::string& host, uint16_t& port,
                               std::string& error);
 
@@ -53,6 +56,9 @@ class SocketcandClient final : public CanBus {
   uint64_t skipped_messages() const noexcept { return skipped_messages_; }
   /// The socket, for poll(); stays owned by this object.
   int native_handle() const noexcept { return fd_; }
+  /// The events to poll native_handle() for: POLLIN, and POLLOUT while a frame is partly
+  /// unsent, so that the caller wakes to let try_receive write it rather than sleeping on it.
+  short poll_events() const noexcept;
   /// "127.0.0.1:29536".
   const std::string& address() const noexcept { return address_; }
 

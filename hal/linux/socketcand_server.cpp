@@ -24,6 +24,18 @@ constexpr int kListenBacklog = 4;
 constexpr int kMaxReadsPerWakeup = 16;           // bounds one wake-up under a flood from the client
 constexpr uint64_t kLoggedErrorsPerClient = 10;  // then they are only counted
 constexpr std::string_view kBusy = "< error busy >";
+// A peer that vanished without a FIN or RST (cable pulled, host powered off, NAT state lost)
+// would hold the only client slot forever: probe an idle connection after 2 s, every 1 s, and
+// give up after 3 unanswered probes (about 5 s); TCP_USER_TIMEOUT ends a connection whose
+// written data stays unacknowledged as long. The drive's own command watchdog acts sooner.
+constexpr int kKeepIdle_s = 2;
+constexpr int kKeepInterval_s = 1;
+constexpr int kKeepProbes = 3;
+constexpr unsigned kUserTimeout_ms = 5000;
+// Every client we know (imdrive, python-can, drive_monitor) is in raw mode within milliseconds
+// of connecting; 3 s leaves room for a loaded machine and frees the slot taken by a port scan
+// or by something that is not a socketcand client.
+constexpr auto kRawModeDeadline = std::chrono::seconds(3);
 
 /// "127.0.0.1:29536", "[::1]:29536".
 std::string address_text(const sockaddr* address) {
@@ -44,7 +56,6 @@ std::string address_text(const sockaddr* address) {
   return text.append(":").append(std::to_string(port));
 }
 
-
 bool passes(const std::vector<CanIdFilter>& filters, const CanFrame& frame) {
   if (filters.empty()) return true;
   for (const CanIdFilter& f : filters) {
@@ -60,6 +71,7 @@ struct SocketcandServer::Client {
   std::string peer;
   SocketcandSession session;
   std::string out;  ///< text not yet written
+  std::chrono::steady_clock::time_point connected_at;
 };
 
 std::unique_ptr<SocketcandServer> SocketcandServer::open(const std::string& host, uint16_t port,
@@ -120,7 +132,11 @@ void SocketcandServer::run_io() noexcept {
     pollfd watch[2] = {{listen_fd_, POLLIN, 0}, {-1, 0, 0}};
     if (client_) {
       watch[1].fd = client_->fd;
-      watch[1].events = static_cast<short>(POLLIN | (client_->out.empty() ? 0 : POLLOUT));
+      // A client that does not read its answers is not read either: its requests wait in TCP,
+      // and its output stays bounded.
+      const bool readable = client_->out.size() < kMaxPendingOutput_bytes;
+      watch[1].events =
+          static_cast<short>((readable ? POLLIN : 0) | (client_->out.empty() ? 0 : POLLOUT));
     }
     ::poll(watch, 2, kPollTimeout_ms);
     // The client first: one that has just left makes room for the next in the same wake-up.
@@ -129,6 +145,12 @@ void SocketcandServer::run_io() noexcept {
       // Answers leave before frames: a client that reads `< ok >` alone after `< rawmode >`
       // (python-can's does) gets it alone whenever the network allows.
       if (client_) write_client();
+    }
+    if (client_ && !client_->session.raw() &&
+        std::chrono::steady_clock::now() - client_->connected_at > kRawModeDeadline) {
+      clients_dropped_.fetch_add(1, std::memory_order_relaxed);
+      if (log_) log_("client " + client_->peer + " dropped: not in raw mode within 3 s");
+      drop_client();
     }
     if ((watch[0].revents & POLLIN) != 0) accept_clients();
     drain_tx();
@@ -155,10 +177,16 @@ void SocketcandServer::accept_clients() noexcept {
     // Frames are small and latency matters more than packet count.
     const int on = 1;
     ::setsockopt(fd, IPPROTO_TCP, TCP_NODELAY, &on, sizeof on);
+    ::setsockopt(fd, SOL_SOCKET, SO_KEEPALIVE, &on, sizeof on);
+    ::setsockopt(fd, IPPROTO_TCP, TCP_KEEPIDLE, &kKeepIdle_s, sizeof kKeepIdle_s);
+    ::setsockopt(fd, IPPROTO_TCP, TCP_KEEPINTVL, &kKeepInterval_s, sizeof kKeepInterval_s);
+    ::setsockopt(fd, IPPROTO_TCP, TCP_KEEPCNT, &kKeepProbes, sizeof kKeepProbes);
+    ::setsockopt(fd, IPPROTO_TCP, TCP_USER_TIMEOUT, &kUserTimeout_ms, sizeof kUserTimeout_ms);
     client_ = std::make_unique<Client>();
     client_->fd = fd;
     client_->peer = who;
     client_->out = SocketcandSession::kGreeting;
+    client_->connected_at = std::chrono::steady_clock::now();
     clients_.fetch_add(1, std::memory_order_relaxed);
     client_connected_.store(true);
     if (log_) log_("client " + who + " connected");
@@ -169,6 +197,7 @@ void SocketcandServer::read_client() noexcept {
   char bytes[4096];
   std::vector<CanFrame> frames;
   for (int i = 0; i < kMaxReadsPerWakeup && client_; ++i) {
+    if (client_->out.size() >= kMaxPendingOutput_bytes) return;  // until it reads its answers
     const ssize_t n = ::recv(client_->fd, bytes, sizeof bytes, 0);
     if (n == 0 || (n < 0 && errno != EINTR && errno != EAGAIN && errno != EWOULDBLOCK)) {
       if (log_) {
@@ -203,6 +232,16 @@ void SocketcandServer::read_client() noexcept {
              (errors == kLoggedErrorsPerClient ? " (further errors are only counted)" : ""));
       }
     }
+    pending_output_bytes_.store(client_->out.size(), std::memory_order_relaxed);
+    if (client_->out.size() > kMaxClientOutput_bytes) {
+      clients_dropped_.fetch_add(1, std::memory_order_relaxed);
+      if (log_) {
+        log_("client " + client_->peer + " dropped: " + std::to_string(client_->out.size()) +
+             " bytes of answers unread");
+      }
+      drop_client();
+      return;
+    }
   }
 }
 
@@ -210,11 +249,13 @@ void SocketcandServer::drain_tx() noexcept {
   for (const CanFrame* next = tx_.front(); next != nullptr; next = tx_.front()) {
     if (!client_ || !client_->session.raw()) {
       tx_.pop();
+      front_held_ = false;
       dropped_no_client_.fetch_add(1, std::memory_order_relaxed);
       continue;
     }
     if (client_->out.size() >= kMaxPendingOutput_bytes) {
-      tx_retries_.fetch_add(1, std::memory_order_relaxed);
+      if (!front_held_) tx_retries_.fetch_add(1, std::memory_order_relaxed);  // once a frame
+      front_held_ = true;
       break;
     }
     timespec now{};
@@ -223,6 +264,7 @@ void SocketcandServer::drain_tx() noexcept {
     // Stored before the pop, so that flush() never sees an empty ring and no pending text.
     pending_output_bytes_.store(client_->out.size(), std::memory_order_relaxed);
     tx_.pop();
+    front_held_ = false;
     sent_.fetch_add(1, std::memory_order_relaxed);
   }
 }
@@ -277,6 +319,7 @@ SocketcandCounters SocketcandServer::socketcand_counters() const noexcept {
   c.dropped_no_client = dropped_no_client_.load();
   c.client_errors = client_errors_.load();
   c.filtered = filtered_.load();
+  c.clients_dropped = clients_dropped_.load();
   return c;
 }
 

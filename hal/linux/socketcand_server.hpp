@@ -8,10 +8,12 @@
 /// The same queue semantics as QueuedCanBus: the tick touches only two lock-free rings, and
 /// one I/O thread waits in poll() (1 ms) on the listening socket and the client. One client
 /// at a time: another is answered `< error busy >` and closed. A client that leaves leaves the
-/// drive running (its command watchdog sees the silence); the next one may connect. Frames of
-/// the drive while no client is in raw mode are dropped and counted; while the client reads
-/// too slowly (kMaxPendingOutput_bytes unsent) they stay queued and are retried, and once the
-/// ring is full the drive counts the telemetry it could not queue.
+/// drive running (its command watchdog sees the silence); the next one may connect. A client
+/// that is not in raw mode 3 s after connecting, or whose peer vanished (TCP keepalive, about
+/// 5 s), or that leaves 64 KiB of answers unread, is dropped. Frames of the drive while no
+/// client is in raw mode are dropped and counted; while the client reads too slowly
+/// (kMaxPendingOutput_bytes unsent) they stay queued and are retried, and the client is not
+/// read; once the ring is full the drive counts the telemetry it could not queue.
 #include <atomic>
 #include <cstdint>
 #include <functional>
@@ -34,6 +36,7 @@ struct SocketcandCounters {
   uint64_t dropped_no_client = 0;  ///< frames of the drive with no client in raw mode
   uint64_t client_errors = 0;      ///< client messages answered `< error ... >`
   uint64_t filtered = 0;           ///< frames of the client outside the filters
+  uint64_t clients_dropped = 0;    ///< closed: not in raw mode in time, or answers left unread
 };
 
 /// Told, from the I/O thread, of clients coming and going and of their errors (one line each).
@@ -44,7 +47,13 @@ class SocketcandServer final : public CanBus {
   static constexpr std::size_t kRingFrames = QueuedCanBus::kRingFrames;
   /// Unsent text for the client beyond which frames wait in the ring: about 100 ms of the
   /// fastest telemetry (1 kHz, ~40 bytes a frame) and the heartbeats.
+  /// The client is not read either while this much is unsent, so that a client that sends
+  /// without reading cannot grow its answers without limit.
   static constexpr std::size_t kMaxPendingOutput_bytes = 8192;
+  /// Unsent text beyond which the client is dropped (logged, counted in clients_dropped): the
+  /// gate above allows only the answers to one read past it, so this is a backstop that keeps
+  /// the drive's locked memory bounded.
+  static constexpr std::size_t kMaxClientOutput_bytes = 64 * 1024;
 
   /// Listens on `host` (a numeric IPv4 or IPv6 address, or localhost: no name lookup, as the
   /// program may be linked statically) and `port` (0: any free port,
@@ -69,11 +78,14 @@ class SocketcandServer final : public CanBus {
   bool flush(int timeout_ms) noexcept;
   /// sent: frames written to the client; received, rx_dropped: frames from the client queued
   /// for the tick, or dropped with the rx ring full; tx_retries: frames held back by a client
-  /// reading too slowly. No error frames over TCP.
+  /// reading too slowly (each counted once, however long it waits). No error frames over TCP.
   QueuedCanCounters counters() const noexcept;
   SocketcandCounters socketcand_counters() const noexcept;
   /// "127.0.0.1:29536", "[::1]:29536": where it listens, with the port bound.
   const std::string& address() const noexcept { return address_; }
+  /// Unsent text for the client, bytes (at most about kMaxPendingOutput_bytes plus the answers
+  /// to one read).
+  std::size_t pending_output_bytes() const noexcept { return pending_output_bytes_.load(); }
   /// Whether a client is connected (in any mode).
   bool client_connected() const noexcept { return client_connected_.load(); }
 
@@ -93,7 +105,8 @@ class SocketcandServer final : public CanBus {
   std::string address_;
   std::vector<CanIdFilter> filters_;
   SocketcandLog log_;
-  std::unique_ptr<Client> client_;      ///< I/O thread only; null while none is connected
+  std::unique_ptr<Client> client_;  ///< I/O thread only; null while none is connected
+  bool front_held_ = false;         ///< I/O thread only: the tx ring's oldest frame is counted held
   SpscRing<CanFrame, kRingFrames> tx_;  ///< tick -> I/O thread
   SpscRing<CanFrame, kRingFrames> rx_;  ///< I/O thread -> tick
   std::atomic<bool> stop_{false};
@@ -101,7 +114,7 @@ class SocketcandServer final : public CanBus {
   std::atomic<std::size_t> pending_output_bytes_{0};
   std::atomic<uint64_t> sent_{0}, received_{0}, rx_dropped_{0}, tx_retries_{0};
   std::atomic<uint64_t> clients_{0}, clients_refused_{0}, dropped_no_client_{0};
-  std::atomic<uint64_t> client_errors_{0}, filtered_{0};
+  std::atomic<uint64_t> client_errors_{0}, filtered_{0}, clients_dropped_{0};
   std::thread io_;
 };
 

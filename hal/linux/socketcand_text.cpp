@@ -211,22 +211,30 @@ SocketcandReply parse_socketcand_reply(std::string_view words) {
   }
   r.kind = Kind::bad;
   uint32_t id = 0;
-  if (w.size() < 3 || w.size() > 4) {
+  // socketcand documents `< frame 123 23.424242 11 22 33 44 >` (a word per byte) and writes
+  // the data as one word; both are read: the data words are joined. Each word holds whole
+  // bytes, so that `1 2` is refused rather than read as 0x12.
+  std::string data;
+  bool whole_bytes = true;
+  for (std::size_t i = 3; i < w.size(); ++i) {
+    data.append(w[i]);
+    whole_bytes = whole_bytes && w[i].size() % 2 == 0;
+  }
+  if (w.size() < 3) {
     r.text = "frame needs ID TIME [DATA]: " + quoted(words);
   } else if (w[1].size() == 8 && parse_hex(w[1], 8, id)) {
     r.kind = Kind::other;
     r.text = "29-bit frame " + std::string(w[1]) + " skipped: the drive uses 11-bit identifiers";
   } else if (!parse_hex(w[1], 3, id) || id > 0x7FF) {
     r.text = "frame: identifier " + quoted(w[1]) + " is not 11-bit hex";
-  } else if (w.size() == 4 && (w[3].size() % 2 != 0 || w[3].size() > 16)) {
-    r.text = "frame " + std::string(w[1]) + ": data " + quoted(w[3]) + " is not 0..8 hex bytes";
+  } else if (!whole_bytes || data.size() > 16) {
+    r.text = "frame " + std::string(w[1]) + ": data " + quoted(data) + " is not 0..8 hex bytes";
   } else {
     r.frame.id = static_cast<uint16_t>(id);
-    const std::string_view data = w.size() == 4 ? w[3] : std::string_view();
     r.frame.length = static_cast<uint8_t>(data.size() / 2);
     for (std::size_t i = 0; i < r.frame.length; ++i) {
       uint32_t byte = 0;
-      if (!parse_hex(data.substr(2 * i, 2), 2, byte)) {
+      if (!parse_hex(std::string_view(data).substr(2 * i, 2), 2, byte)) {
         r.text = "frame " + std::string(w[1]) + ": data " + quoted(data) + " is not hex";
         return r;
       }

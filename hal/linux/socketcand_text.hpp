@@ -65,8 +65,9 @@ struct SocketcandReply {
   std::string text;  ///< error: the server's words; other, bad: what was not understood
 };
 
-/// Parses the words of one server message. `frame ID SECS.USECS [HEX]` takes an 11-bit
-/// identifier (1 to 3 hex digits) and 0..8 bytes as contiguous hex; a 29-bit identifier
+/// Parses the words of one server message. `frame ID SECS.USECS [HEX ..]` takes an 11-bit
+/// identifier (1 to 3 hex digits) and 0..8 bytes, as contiguous hex (what socketcand writes) or
+/// a word per byte (what its protocol description shows), joined; a 29-bit identifier
 /// (8 digits) is `other` (the drive has none), a malformed frame is `bad`.
 SocketcandReply parse_socketcand_reply(std::string_view words);
 

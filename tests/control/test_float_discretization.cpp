@@ -82,6 +82,9 @@ struct Worst {
   std::vector<double> error_u = std::vector<double>(std::size(kVoltageFed), 0.0);
   std::vector<double> bound_u = std::vector<double>(std::size(kVoltageFed), 0.0);
   std::vector<double> max_u = std::vector<double>(std::size(kVoltageFed), 0.0);  ///< any case
+  /// The bound of the case with the largest error.
+  std::vector<double> bound_at_max_u = std::vector<double>(std::size(kVoltageFed), 0.0);
+  double smallest_bound_u = INFINITY, largest_bound_u = 0.0;  ///< over the cases
 };
 
 void check_voltage_fed(const MotorParameters& m, double delta_s, double eta_in_u,
@@ -89,6 +92,8 @@ void check_voltage_fed(const MotorParameters& m, double delta_s, double eta_in_u
   const VoltageFedCoefficients ref = discretize_voltage_fed(m, to_float(delta_s));
   const VoltageFedCoefficients f = discretize_voltage_fed<float>(m, delta_s);
   const double bound_u = voltage_fed_bound_u(m, delta_s, eta_in_u);
+  worst.smallest_bound_u = std::min(worst.smallest_bound_u, bound_u);
+  worst.largest_bound_u = std::max(worst.largest_bound_u, bound_u);
   for (std::size_t i = 0; i < std::size(kVoltageFed); ++i) {
     const double r = ref.*kVoltageFed[i].field, v = f.*kVoltageFed[i].field;
     if (r == 0.0) {  // no friction: the exact zero must come out as zero
@@ -98,7 +103,10 @@ void check_voltage_fed(const MotorParameters& m, double delta_s, double eta_in_u
     const double error_u = std::abs(v - r) / std::abs(r) / kUnitRoundoff;
     EXPECT_LE(error_u, bound_u) << label << " " << kVoltageFed[i].name << " float " << v
                                 << " double " << r;
-    worst.max_u[i] = std::max(worst.max_u[i], error_u);
+    if (error_u >= worst.max_u[i]) {
+      worst.max_u[i] = error_u;
+      worst.bound_at_max_u[i] = bound_u;
+    }
     if (error_u / bound_u > worst.error_u[i] / std::max(worst.bound_u[i], 1.0)) {
       worst.error_u[i] = error_u;  // the case closest to its bound
       worst.bound_u[i] = bound_u;
@@ -107,10 +115,13 @@ void check_voltage_fed(const MotorParameters& m, double delta_s, double eta_in_u
 }
 
 void print(const char* title, const Worst& worst) {
-  std::printf("%s\n", title);
+  std::printf("%s bound %.1f u to %.1f u over the cases\n", title, worst.smallest_bound_u,
+              worst.largest_bound_u);
   for (std::size_t i = 0; i < std::size(kVoltageFed); ++i) {
-    std::printf("  %-22s largest error %5.1f u; closest to its bound: %5.1f u of %6.1f u\n",
-                kVoltageFed[i].name, worst.max_u[i], worst.error_u[i], worst.bound_u[i]);
+    std::printf("  %-22s largest error %5.1f u (bound %6.1f u); closest to its bound: %5.1f u "
+                "of %6.1f u\n",
+                kVoltageFed[i].name, worst.max_u[i], worst.bound_at_max_u[i], worst.error_u[i],
+                worst.bound_u[i]);
   }
 }
 

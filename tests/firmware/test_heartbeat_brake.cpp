@@ -33,7 +33,8 @@ struct BrakeRig {
   sim::SimBoard board;
   Drive<double> drive;
   protocol::CommandEncoder host{1};
-  std::optional<int64_t> last_brake;  ///< the brake signal of the last heartbeat
+  std::optional<int64_t> first_brake;  ///< the brake signal of the first heartbeat
+  std::optional<int64_t> last_brake;   ///< the brake signal of the last heartbeat
 
   static DriveConfig config(bool brake_fitted) {
     DriveConfig c;
@@ -62,6 +63,7 @@ struct BrakeRig {
       for (hal::CanFrame f; board.can_side().take_sent(f);) {
         if (f.id == protocol::can_id(1, MessageId::heartbeat)) {
           last_brake = protocol::get_raw(f.data, kBrake);
+          if (!first_brake) first_brake = last_brake;
         }
       }
     }
@@ -75,6 +77,18 @@ struct BrakeRig {
     run(2000, speed_rad_s);  // two heartbeat periods
   }
 };
+
+// The first heartbeat is published before any tick has computed the brake signal: it carries
+// the value the drive starts with.
+TEST(HeartbeatBrake, TheFirstHeartbeatReportsTheBrakeAsFitted) {
+  for (const bool fitted : {false, true}) {
+    SCOPED_TRACE(fitted ? "brake fitted" : "no brake");
+    BrakeRig rig(fitted);
+    for (int n = 0; n < 20 && !rig.first_brake; ++n) rig.run(100, 0.0f);
+    ASSERT_TRUE(rig.first_brake.has_value());
+    EXPECT_EQ(*rig.first_brake, fitted ? 1 : 0);
+  }
+}
 
 TEST(HeartbeatBrake, ADriveWithoutABrakeReportsNoneStoppedOrTurning) {
   BrakeRig rig(false);

@@ -1,13 +1,18 @@
 // SocketcandClient against the project's own SocketcandServer on loopback TCP (the handshake,
 // frames both ways, one client at a time, the connection lost when the server goes, the error
 // when nothing listens), against a raw server that writes one byte at a time (partial reads),
+// against one that writes a long burst at once (what the last read brought is parsed) or reads
+// nothing for a while (POLLOUT asked for while a frame is unsent),
 // and the client's side of the text: server messages parsed, `< send ... >` formatted.
 #include <arpa/inet.h>
 #include <gtest/gtest.h>
 #include <netinet/in.h>
+#include <poll.h>
+#include <sys/ioctl.h>
 #include <sys/socket.h>
 #include <unistd.h>
 
+#include <atomic>
 #include <chrono>
 #include <string>
 #include <thread>
@@ -162,6 +167,109 @@ struct TricklingServer {
   }
 };
 
+/// A listening socket whose one client gets the handshake's answers, then (once `go`) `burst`
+/// in one write; it then reads what the client sends once `drain` is set.
+struct BurstServer {
+  int listen_fd = -1;
+  uint16_t port = 0;
+  std::atomic<bool> go{false}, drain{false}, done{false};
+  std::thread thread;
+  explicit BurstServer(std::string burst) {
+    listen_fd = ::socket(AF_INET, SOCK_STREAM, 0);
+    const int small_bytes = 4096;  // so that a client's unread sends soon fill TCP
+    ::setsockopt(listen_fd, SOL_SOCKET, SO_RCVBUF, &small_bytes, sizeof small_bytes);
+    sockaddr_in address{};
+    address.sin_family = AF_INET;
+    address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    socklen_t length = sizeof address;
+    EXPECT_EQ(::bind(listen_fd, reinterpret_cast<sockaddr*>(&address), length), 0);
+    EXPECT_EQ(::listen(listen_fd, 1), 0);
+    ::getsockname(listen_fd, reinterpret_cast<sockaddr*>(&address), &length);
+    port = ntohs(address.sin_port);
+    thread = std::thread([this, burst] {
+      const int fd = ::accept(listen_fd, nullptr, nullptr);
+      char bytes[4096];
+      ::send(fd, "< hi >", 6, MSG_NOSIGNAL);
+      EXPECT_GT(::recv(fd, bytes, sizeof bytes, 0), 0);
+      ::send(fd, "< ok >", 6, MSG_NOSIGNAL);
+      EXPECT_GT(::recv(fd, bytes, sizeof bytes, 0), 0);
+      ::send(fd, "< ok >", 6, MSG_NOSIGNAL);
+      while (!go && !done) std::this_thread::sleep_for(1ms);
+      for (std::size_t at = 0; at < burst.size();) {
+        const ssize_t n = ::send(fd, burst.data() + at, burst.size() - at, MSG_NOSIGNAL);
+        if (n <= 0) break;
+        at += static_cast<std::size_t>(n);
+      }
+      while (!drain && !done) std::this_thread::sleep_for(1ms);
+      while (!done) {
+        pollfd watch{fd, POLLIN, 0};
+        if (::poll(&watch, 1, 10) == 1 && ::recv(fd, bytes, sizeof bytes, 0) <= 0) break;
+      }
+      ::close(fd);
+    });
+  }
+  ~BurstServer() {
+    done = true;
+    thread.join();
+    ::close(listen_fd);
+  }
+};
+
+TEST(SocketcandClient, ParsesWhatItsLastReadBrought) {
+  // try_receive reads at most 17 times (4096 bytes each) per call. The burst is exactly 17
+  // reads long, skipped `< echo >` messages first and a frame last: the 17th read brings the
+  // frame, and the call must return it rather than leave it in the reader while the socket is
+  // empty (a caller polling the socket would then never learn of it).
+  const std::string frame_text = "< frame 021 1.000001 0102 >";
+  std::string burst;
+  while (burst.size() + 8 + frame_text.size() <= 17 * 4096) burst += "< echo >";
+  burst.append(17 * 4096 - frame_text.size() - burst.size(), ' ');
+  burst += frame_text;
+  ASSERT_EQ(burst.size(), 17u * 4096u);
+  BurstServer server(burst);
+  std::string error;
+  const auto client = SocketcandClient::open("127.0.0.1", server.port, error);
+  ASSERT_TRUE(client) << error;
+  server.go = true;
+  int queued_bytes = 0;  // the whole burst in the client's socket before the one call
+  const auto deadline = std::chrono::steady_clock::now() + kWait;
+  while (queued_bytes < static_cast<int>(burst.size()) &&
+         std::chrono::steady_clock::now() < deadline) {
+    std::this_thread::sleep_for(1ms);
+    ::ioctl(client->native_handle(), FIONREAD, &queued_bytes);
+  }
+  ASSERT_EQ(queued_bytes, static_cast<int>(burst.size()));
+  CanFrame got;
+  ASSERT_TRUE(client->try_receive(got));
+  EXPECT_EQ(got.id, 0x021);
+  EXPECT_EQ(got.data[1], 0x02);
+}
+
+TEST(SocketcandClient, AsksToBeWokenWhileAFrameIsUnsent) {
+  BurstServer server("");
+  std::string error;
+  const auto client = SocketcandClient::open("127.0.0.1", server.port, error);
+  ASSERT_TRUE(client) << error;
+  EXPECT_EQ(client->poll_events(), POLLIN);
+  // The server reads nothing: TCP fills, then the client keeps the rest pending.
+  int sends = 0;
+  while (client->try_send(frame_of(0x021, {1, 2, 3, 4, 5, 6, 7, 8})) && sends < 1'000'000) {
+    ++sends;
+  }
+  ASSERT_TRUE(client->lost().empty()) << client->lost();
+  EXPECT_EQ(client->poll_events(), POLLIN | POLLOUT);
+  server.drain = true;
+  // Woken for POLLOUT, try_receive writes what is pending; soon nothing is.
+  const auto deadline = std::chrono::steady_clock::now() + kWait;
+  CanFrame got;
+  while (client->poll_events() != POLLIN && std::chrono::steady_clock::now() < deadline) {
+    pollfd watch{client->native_handle(), client->poll_events(), 0};
+    ::poll(&watch, 1, 50);
+    EXPECT_FALSE(client->try_receive(got));
+  }
+  EXPECT_EQ(client->poll_events(), POLLIN);
+}
+
 TEST(SocketcandClient, ReadsMessagesCutAnywhere) {
   // `< ok >` and the first frame are written together: the frame must not be lost.
   TricklingServer server("< hi >\x01< ok >\x01< ok >< frame 21 1.000001 0102 >  < frame 7FF 2.5 >");
@@ -200,6 +308,20 @@ TEST(SocketcandText, ParsesWhatAServerSays) {
   EXPECT_EQ(parse_socketcand_reply("hello").kind, Kind::other);
 }
 
+TEST(SocketcandText, ReadsTheDocumentedFrameWithAWordPerByte) {
+  using Kind = SocketcandReply::Kind;
+  // socketcand's doc/protocol.md shows this form; its server writes the contiguous one.
+  const SocketcandReply frame = parse_socketcand_reply("frame 123 23.424242 11 22 33 44");
+  ASSERT_EQ(frame.kind, Kind::frame) << frame.text;
+  EXPECT_EQ(frame.frame.id, 0x123);
+  ASSERT_EQ(frame.frame.length, 4);
+  EXPECT_EQ(frame.frame.data[0], 0x11);
+  EXPECT_EQ(frame.frame.data[3], 0x44);
+  EXPECT_EQ(parse_socketcand_reply("frame 1 1.0 11 22 33 44 55 66 77 88 99").kind, Kind::bad);
+  EXPECT_EQ(parse_socketcand_reply("frame 1 1.0 1 2").kind, Kind::bad);  // not 0x12
+  EXPECT_EQ(parse_socketcand_reply("frame 1 1.0 11 2G").kind, Kind::bad);
+}
+
 TEST(SocketcandText, FormatsASendTheServerAccepts) {
   const CanFrame frame = frame_of(0x21, {0x01, 0xAB});
   const std::string text = format_socketcand_send(frame);
@@ -211,7 +333,8 @@ TEST(SocketcandText, FormatsASendTheServerAccepts) {
   EXPECT_EQ(format_socketcand_send(frame_of(0x7FF, {})), "< send 7FF 0 >");
 }
 
-TEST(SocketcandAddress, TakesHostColonPort) {
+TEST(SocketcandAddress, TakesPortHostColonPortAndBracketedV6) {
+  // The same forms as imdrive's --socketcand (tests/python/test_socketcand_bus.py).
   std::string host, error;
   uint16_t port = 0;
   ASSERT_TRUE(parse_socketcand_address("127.0.0.1:29536", host, port, error));
@@ -219,9 +342,15 @@ TEST(SocketcandAddress, TakesHostColonPort) {
   EXPECT_EQ(port, 29536);
   ASSERT_TRUE(parse_socketcand_address("[::1]:7", host, port, error));
   EXPECT_EQ(host, "::1");
-  for (const char* bad : {"29536", "host:", ":5", "h:0", "h:70000", "h:12x"}) {
+  EXPECT_EQ(port, 7);
+  ASSERT_TRUE(parse_socketcand_address("29536", host, port, error));
+  EXPECT_EQ(host, "127.0.0.1");
+  EXPECT_EQ(port, 29536);
+  for (const char* bad : {"host:", ":5", "h:0", "h:70000", "h:12x", "h:+5", "h: 5", "0", ""}) {
     EXPECT_FALSE(parse_socketcand_address(bad, host, port, error)) << bad;
-    EXPECT_EQ(error, std::string("--socketcand ") + bad + ": give HOST:PORT, e.g. 127.0.0.1:29536");
+    EXPECT_EQ(error, std::string("--socketcand ") + bad +
+                         ": expected PORT, HOST:PORT or [V6]:PORT with a port in 1..65535, "
+                         "e.g. 127.0.0.1:29536");
   }
 }
 

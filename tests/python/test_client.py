@@ -149,3 +149,37 @@ def test_readme_example(fake_and_bus, source_dir):
     assert names[:2] == ["enable", "set_speed"] and names[-1] == "disable"
     assert set(names) == {"enable", "set_speed", "disable"}  # the keep-alive repeats set_speed
     assert all(result == "accepted" for _, result in fake.received)
+
+
+def test_enable_waits_for_the_end_of_the_offset_calibration():
+    """A script started with the drive: its first heartbeat says calibrating, and enable then
+    would be refused (not_allowed). enable() waits for the drive to leave calibrating."""
+    import can
+    from fake_drive import FakeDrive
+    fake = FakeDrive("imdrive-test-calibrating")
+    bus = can.Bus(interface="virtual", channel="imdrive-test-calibrating")
+    try:
+        with imdrive.Drive(bus, 1) as drive:
+            assert drive.enable(keep_alive=False).result == "accepted"
+            assert ("enable", "accepted") in fake.received
+            assert ("enable", "not_allowed") not in fake.received
+    finally:
+        bus.shutdown()
+        fake.close()
+
+
+def test_enable_on_a_drive_stuck_calibrating_says_so():
+    import can
+    from fake_drive import FakeDrive
+    fake = FakeDrive("imdrive-test-stuck")
+    with fake._lock:
+        fake.calibrated_at = float("inf")  # an ADC that never settles
+    bus = can.Bus(interface="virtual", channel="imdrive-test-stuck")
+    try:
+        with imdrive.Drive(bus, 1) as drive:
+            with pytest.raises(imdrive.NoAnswer, match="still calibrating"):
+                drive.enable(keep_alive=False, calibration_timeout_s=0.3)
+            assert not any(name == "enable" for name, _ in fake.received)
+    finally:
+        bus.shutdown()
+        fake.close()

@@ -124,12 +124,28 @@ def test_reader_skips_garbage_and_bounds_an_endless_message():
         parse_frame("frame 21 1.0 0")  # an odd number of hex digits
 
 
+def test_reads_the_documented_frame_with_a_word_per_byte():
+    # socketcand's doc/protocol.md shows this form; its server writes the contiguous one.
+    message = parse_frame("frame 123 23.424242 11 22 33 44")
+    assert message.arbitration_id == 0x123 and not message.is_extended_id
+    assert bytes(message.data) == bytes([0x11, 0x22, 0x33, 0x44])
+    assert message.timestamp == pytest.approx(23.424242)  # parsed from text: one rounding
+    assert bytes(parse_frame("frame 21 1.0 1122").data) == b"\x11\x22"
+    for bad in ("frame 21 1.0 1 2", "frame 21 1.0 11 2G", "frame 21 1.0 " + "11 " * 9):
+        with pytest.raises(ValueError):
+            parse_frame(bad)
+
+
 def test_host_port_and_socketcan_errors():
     assert parse_host_port("29536") == ("127.0.0.1", 29536)
     assert parse_host_port("10.0.0.2:29536") == ("10.0.0.2", 29536)
     assert parse_host_port("[::1]:29536") == ("::1", 29536)
-    with pytest.raises(BusOpenError, match="expected HOST:PORT"):
-        parse_host_port("host:")
+    # The forms drive_monitor refuses too (tests/hal/test_socketcand_client.cpp), same message.
+    for bad in ("host:", ":5", "h:0", "h:70000", "h:12x", "h:+5", "h: 5", "0", "", "h:\u00b2"):
+        with pytest.raises(BusOpenError) as caught:
+            parse_host_port(bad)
+        assert str(caught.value) == (f"--socketcand {bad}: expected PORT, HOST:PORT or "
+                                     f"[V6]:PORT with a port in 1..65535, e.g. 127.0.0.1:29536")
     text = socketcan_error_text("vcan0", OSError(errno.EAFNOSUPPORT, "Address family not "
                                                  "supported by protocol"))
     assert "this kernel has no CAN support" in text

@@ -21,7 +21,9 @@ spread; running_from_s must match within 2 ticks.
 
 Also checked: the run completed (exit status 0: no fault, no overrun), every tick ran, and the
 control path's instructions per tick (QEMU -icount shift=0: 1 ns of virtual time per
-instruction) are printed, with the 100 us budget at 170 MHz.
+instruction) are printed, with the 100 us budget at 170 MHz. The image's measurement of a float
+recompute of the exact discretization (its `pil recompute` line) must be present, take time,
+and fit inside the stack its probe paints; its cost is printed.
 """
 import argparse
 import json
@@ -36,6 +38,9 @@ METRICS = ["speed_rms_err_rad_s", "speed_max_err_rad_s", "flux2_rms_err_Wb2",
 SD_LIMIT = 5.0
 TICK_S = 1e-4
 QEMU_TIMEOUT_S = 600  # about 30 s on this machine's 2 cores
+# The stack the recompute probe paints (kProbeBytes, firmware/cortex_m/pil/recompute_probe.hpp):
+# a run that overflows it reads as exactly this size.
+RECOMPUTE_PROBE_BYTES = 2048
 
 
 def run_pil(elf, scenario, controller):
@@ -125,6 +130,17 @@ def main():
         per_stage.append(f"{stage} {counts * 1e9 / clock_Hz:.0f}")
     print("pil_test: instructions per stage (timed ticks, each with one clock read): " +
           ", ".join(per_stage))
+
+    # The float recompute of the discretization, measured by the image before its first tick.
+    recompute_ns = int(pil.get("recompute.ns_mean", "-1"))
+    recompute_stack = int(pil.get("recompute.stack_bytes", "-1"))
+    check("recompute.ns_mean" in pil and recompute_ns > 0, "the recompute was timed",
+          f"ns_mean {pil.get('recompute.ns_mean')}")
+    check(0 < recompute_stack < RECOMPUTE_PROBE_BYTES,
+          f"the recompute's stack within the probe's {RECOMPUTE_PROBE_BYTES} B",
+          f"stack_bytes {pil.get('recompute.stack_bytes')}")
+    print(f"pil_test: float recompute of the discretization: {recompute_ns} instructions, "
+          f"{recompute_stack} B of stack, over {pil.get('recompute.runs')} runs")
     print(f"pil_test: {'passed' if failed == 0 else f'{failed} check(s) failed'}")
     return 0 if failed == 0 else 1
 

@@ -72,7 +72,7 @@ void wait_readable(const LiveBus& bus, Clock::time_point deadline) {
       0, std::chrono::duration_cast<std::chrono::nanoseconds>(deadline - Clock::now()).count());
   const timespec timeout{static_cast<time_t>(left_ns / 1'000'000'000),
                          static_cast<long>(left_ns % 1'000'000'000)};
-  pollfd fd{bus.native_handle(), POLLIN, 0};
+  pollfd fd{bus.native_handle(), bus.poll_events(), 0};
   ::ppoll(&fd, 1, &timeout, g_wait_mask);
 }
 

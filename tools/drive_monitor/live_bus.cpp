@@ -1,5 +1,7 @@
 #include "tools/drive_monitor/live_bus.hpp"
 
+#include <poll.h>
+
 #include <cerrno>
 #include <cstring>
 
@@ -10,7 +12,8 @@ CLI::Option* add_bus_options(CLI::App& command, BusChoice& choice) {
       command.add_option("--can", choice.can, "CAN interface (SocketCAN), e.g. can0");
   command
       .add_option("--socketcand", choice.socketcand,
-                  "socketcand server instead of an interface, HOST:PORT, e.g. 127.0.0.1:29536 "
+                  "socketcand server instead of an interface: PORT (on 127.0.0.1), HOST:PORT or "
+                  "[V6]:PORT, e.g. 127.0.0.1:29536 "
                   "(drive_hil --can socketcand:29536)")
       ->excludes(can);
   return can;
@@ -39,6 +42,10 @@ bool LiveBus::try_send(const hal::CanFrame& frame) noexcept {
 
 bool LiveBus::try_receive(hal::CanFrame& frame) noexcept {
   return socketcan_ ? socketcan_->try_receive(frame) : socketcand_->try_receive(frame);
+}
+
+short LiveBus::poll_events() const noexcept {
+  return socketcand_ ? socketcand_->poll_events() : static_cast<short>(POLLIN);
 }
 
 int LiveBus::native_handle() const noexcept {

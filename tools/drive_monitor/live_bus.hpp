@@ -35,6 +35,8 @@ class LiveBus final : public hal::CanBus {
 
   /// The descriptor to wait on for received frames.
   int native_handle() const noexcept;
+  /// The events to poll native_handle() for (POLLOUT too while a socketcand frame is unsent).
+  short poll_events() const noexcept;
   /// Why the bus is gone (interface down or removed, server closed the connection); nullopt
   /// while it works. Waiting for it to come back is not this tool's job.
   std::optional<std::string> lost() const;

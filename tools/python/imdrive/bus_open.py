@@ -15,15 +15,18 @@ class BusOpenError(Exception):
 
 
 def parse_host_port(text):
-    """'HOST:PORT', '[::1]:PORT' or 'PORT' (host 127.0.0.1) -> (host, port)."""
+    """'PORT' (host 127.0.0.1), 'HOST:PORT' or '[V6]:PORT' -> (host, port), by the same rules
+    as drive_monitor's parse_socketcand_address (hal/linux/socketcand_client.cpp)."""
     host, colon, port = text.rpartition(":")
     if not colon:
         host = DEFAULT_HOST
     elif host.startswith("[") and host.endswith("]"):
         host = host[1:-1]
-    if not host or not port.isdigit() or not 0 < int(port) <= 65535:
-        raise BusOpenError(f"--socketcand {text}: expected HOST:PORT with a port in 1..65535, "
-                           f"e.g. 127.0.0.1:29536")
+    # ASCII digits only, at most 5 of them, as the C++ parser takes them.
+    if not host or not (port.isascii() and port.isdigit() and len(port) <= 5) \
+            or not 0 < int(port) <= 65535:
+        raise BusOpenError(f"--socketcand {text}: expected PORT, HOST:PORT or [V6]:PORT with a "
+                           f"port in 1..65535, e.g. 127.0.0.1:29536")
     return host, int(port)
 
 

@@ -258,14 +258,16 @@ def _open_output(path, flag):
 
 def _check_plot_target(args):
     """Before any frame is read: a --save name matplotlib writes as PNG in a directory that
-    exists, or a display for the live window."""
+    exists, or a display for the live window. Only on Linux does a window need DISPLAY or
+    WAYLAND_DISPLAY: macOS and Windows draw without either."""
     if args.save:
         if not args.save.lower().endswith(".png"):
             raise UsageError(f"--save {args.save}: the file name must end in .png")
         folder = os.path.dirname(os.path.abspath(args.save))
         if not os.path.isdir(folder):
             raise UsageError(f"--save {args.save}: no directory {folder}")
-    elif not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")):
+    elif sys.platform.startswith("linux") and not (os.environ.get("DISPLAY")
+                                                   or os.environ.get("WAYLAND_DISPLAY")):
         raise UsageError("no display for a live window (DISPLAY is not set): "
                          "give --save FILE.png")
 

@@ -307,8 +307,13 @@ class Drive(ParameterService):
             with self._changed:
                 self._waiting.pop(key, None)
 
-    def enable(self, keep_alive=True):
-        """idle -> magnetizing -> running; starts the keep-alive (set_speed 0 until set_speed)."""
+    def enable(self, keep_alive=True, calibration_timeout_s=5.0):
+        """idle -> magnetizing -> running; starts the keep-alive (set_speed 0 until set_speed).
+        A drive that has just started measures its ADC offsets first (state calibrating, with
+        the PWM off) and refuses enable meanwhile: a script started with the drive would race
+        it, so this waits for a heartbeat past calibrating, up to calibration_timeout_s."""
+        self.wait(lambda: self.heartbeat is not None and self.state != "calibrating",
+                  calibration_timeout_s, "still calibrating its ADC offsets (state calibrating)")
         ack = self.send("enable")
         if keep_alive:
             self.keep_alive.start()

@@ -70,12 +70,16 @@ class MessageReader:
 
 
 def parse_frame(words, channel=None):
-    """`frame ID SECONDS.MICROS [HEXDATA]` -> can.Message; ValueError if malformed. An
-    identifier of 8 hex digits is a 29-bit one (socketcand writes 3 or 8)."""
+    """`frame ID SECONDS.MICROS [HEXDATA ..]` -> can.Message; ValueError if malformed. An
+    identifier of 8 hex digits is a 29-bit one (socketcand writes 3 or 8). The data is one
+    contiguous word (what socketcand writes) or a word per byte (what its protocol description
+    shows, `< frame 123 23.424242 11 22 33 44 >`): the words are joined, each of whole bytes."""
     parts = words.split()
-    if len(parts) not in (3, 4) or parts[0] != "frame":
+    if len(parts) < 3 or parts[0] != "frame":
         raise ValueError(f"not a frame message: '< {words} >'")
-    data = bytes.fromhex(parts[3]) if len(parts) == 4 else b""
+    if any(len(word) % 2 for word in parts[3:]):
+        raise ValueError(f"data not in whole hex bytes: '< {words} >'")
+    data = bytes.fromhex("".join(parts[3:]))
     if len(data) > 8:
         raise ValueError(f"more than 8 data bytes: '< {words} >'")
     return can.Message(timestamp=float(parts[2]), arbitration_id=int(parts[1], 16),
