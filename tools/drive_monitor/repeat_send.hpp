@@ -58,6 +58,17 @@ struct RepeatPlan {
 /// product that is a whole number up to rounding (0.3 s at 10 Hz) counts as that number.
 uint64_t repeat_slot_count(double rate_Hz, double duration_s);
 
+/// A command sent once before the repeated one (`send set-speed --enable`: the enable), and
+/// what became of it. At namespace scope, not nested in RepeatTally: a nested class with
+/// default member initializers is not constructible inside its enclosing class for clang 14.
+struct RepeatLead {
+  firmware::protocol::Command command;
+  bool sent = false;                                        ///< the socket took it
+  bool send_failed = false;                                 ///< the socket refused it
+  std::optional<firmware::protocol::CommandResult> result;  ///< its ack's
+  bool unanswered = false;                                  ///< sent, no ack in time
+};
+
 /// What happened to the frames of a repeated command.
 struct RepeatTally {
   uint64_t planned = 0;        ///< slots in the plan
@@ -73,14 +84,7 @@ struct RepeatTally {
   std::optional<double> stopped_after_s;
 
   /// The lead command and what became of it (only with a lead).
-  struct Lead {
-    firmware::protocol::Command command;
-    bool sent = false;                                        ///< the socket took it
-    bool send_failed = false;                                 ///< the socket refused it
-    std::optional<firmware::protocol::CommandResult> result;  ///< its ack's
-    bool unanswered = false;                                  ///< sent, no ack in time
-  };
-  std::optional<Lead> lead;
+  std::optional<RepeatLead> lead;
 
   uint64_t rejected_total() const;
 };
