@@ -195,7 +195,7 @@ void SoakHost::start_segment(double t_s, sim::SimBoard& board,
     f.surge_A = 3.0 * s_.i_max_A;  // past the 1.5 i_max trip whatever the phase carries
     f.phase = std::uniform_int_distribution<int>(0, 2)(rng_);
     f.bus_V = f.kind == sim::FaultKind::overvoltage ? 1.45 * s_.v_bus_V : 0.5 * s_.v_bus_V;
-    f.stall_us = 250'000.0;
+    f.stall_us = 2.5e6;  // 2.5 x the soak's tick budget (soak.cpp), within the 32-bit ns clock
     f.until_s = t_s + 0.3;
     if (!board.inject(f)) {
       violation(t_s, "the board refused a fault");
