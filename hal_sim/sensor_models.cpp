@@ -8,7 +8,8 @@
 
 namespace imd::sim {
 
-AdcModel::AdcModel(const AdcModelConfig& config, uint64_t seed) : config_(config), rng_(seed) {
+AdcModel::AdcModel(const AdcModelConfig& config, uint64_t seed)
+    : config_(config), unit_normal_(seed) {
   const int codes = 1 << config.bits;
   scale_.phase_A_per_code = static_cast<float>(2.0 * config.full_scale_A / codes);
   scale_.phase_mid_code = static_cast<uint16_t>(codes / 2);
@@ -16,8 +17,20 @@ AdcModel::AdcModel(const AdcModelConfig& config, uint64_t seed) : config_(config
   scale_.max_code = static_cast<uint16_t>(codes - 1);
 }
 
+namespace {
+
+/// std::round (halves away from zero) without the library call, for |x| < 2^52: the
+/// truncation is exact there, and so is x minus it.
+double round_half_away(double x) noexcept {
+  if (!(std::fabs(x) < 0x1p52)) return std::round(x);
+  const auto whole = static_cast<double>(static_cast<int64_t>(x));
+  return std::fabs(x - whole) >= 0.5 ? whole + std::copysign(1.0, x) : whole;
+}
+
+}  // namespace
+
 uint16_t AdcModel::to_code(double value, double per_code, int mid) const noexcept {
-  const double code = std::round(value / per_code) + mid;
+  const double code = round_half_away(value / per_code) + mid;
   return static_cast<uint16_t>(std::clamp(code, 0.0, static_cast<double>(scale_.max_code)));
 }
 
@@ -26,10 +39,10 @@ hal::AdcSample AdcModel::convert(const std::array<double, 3>& i_abc_A, double v_
   const double a_per_code = 2.0 * config_.full_scale_A / (1 << config_.bits);
   for (int phase = 0; phase < 3; ++phase) {
     const double measured =
-        i_abc_A[phase] + config_.offset_A[phase] + config_.noise_A * unit_normal_(rng_);
+        i_abc_A[phase] + config_.offset_A[phase] + config_.noise_A * unit_normal_();
     sample.phase_code[phase] = to_code(measured, a_per_code, scale_.phase_mid_code);
   }
-  const double bus = v_bus_V + config_.bus_noise_V * unit_normal_(rng_);
+  const double bus = v_bus_V + config_.bus_noise_V * unit_normal_();
   sample.bus_code = to_code(bus, config_.bus_full_scale_V / (1 << config_.bits), 0);
   return sample;
 }

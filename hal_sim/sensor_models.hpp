@@ -4,11 +4,11 @@
 /// average phase voltages of a two-level inverter.
 #include <array>
 #include <cstdint>
-#include <random>
 
 #include "control/frames.hpp"
 #include "hal/current_adc.hpp"
 #include "hal/pwm.hpp"
+#include "hal_sim/gaussian_noise.hpp"
 
 namespace imd::sim {
 
@@ -33,8 +33,7 @@ class AdcModel {
 
   AdcModelConfig config_;
   hal::AdcScale scale_;
-  std::mt19937_64 rng_;
-  std::normal_distribution<double> unit_normal_{0.0, 1.0};
+  GaussianNoise unit_normal_;
 };
 
 /// Encoder count of a mechanical angle: floor(theta cpr / 2 pi), wrapped to 32 bits like a

@@ -28,19 +28,30 @@ firmware::DriveConfig drive_config(const Scenario& s);
 ScenarioProfiles profiles(const Scenario& s);
 
 /// The scenario's profiles as the reference source of a drive of arithmetic T: evaluated in
-/// double at each tick's time, then rounded to T.
+/// double at each tick's time, then rounded to T. The drive asks for a tick several times
+/// (its look-ahead asks for k + 1 and k + 2 at tick k): the last few ticks' references are
+/// kept, so that each profile (a sine: about 140 instructions) is evaluated once per tick.
 template <typename T>
 class ScenarioReferences final : public firmware::ReferenceSource<T> {
  public:
   explicit ScenarioReferences(const Scenario& s)
       : profiles_(profiles(s)), period_s_(s.sample_period_s) {}
   firmware::Reference<T> at_tick(uint64_t k) const noexcept override {
-    return reference_at_tick<T>(profiles_, period_s_, k);
+    Kept& kept = kept_[k % kKept];
+    if (!kept.valid || kept.k != k) kept = {true, k, reference_at_tick<T>(profiles_, period_s_, k)};
+    return kept.reference;
   }
 
  private:
+  static constexpr uint64_t kKept = 4;
+  struct Kept {
+    bool valid = false;
+    uint64_t k = 0;
+    firmware::Reference<T> reference{};
+  };
   ScenarioProfiles profiles_;
   double period_s_;
+  mutable Kept kept_[kKept];  // a cache: the same values as evaluating again
 };
 
 }  // namespace imd::sim

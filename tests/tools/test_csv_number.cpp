@@ -1,4 +1,4 @@
-// drive_sim's number formatting (tools/drive_sim/csv_number.hpp, std::to_chars) against fmt's
+// drive_sim's number formatting (tools/drive_sim/csv_number.hpp) against fmt's
 // "{:.10g}", the text its CSV had before: byte for byte, on every kind of double (random bit
 // patterns cover every exponent), on values near the ties and decade boundaries where two
 // shortest-digit algorithms could round differently, and on the magnitudes of a simulation row.
@@ -44,6 +44,12 @@ TEST(CsvNumber, SameTextAsFmt) {
     check(base + 0.5);
     check((base + 0.5) * 1e-5);
     check(base / 1024.0);
+    // The same ties at every decade of the fast path (1e-13 to 1e9), and their neighbours a
+    // few ulps away, on either side of the margin where it hands over to the exact path.
+    const double tie = (base + 0.5) * std::pow(10.0, -int(random() % 24));
+    check(tie);
+    check(std::nextafter(tie, 0.0));
+    check(std::nextafter(std::nextafter(std::nextafter(tie, INFINITY), INFINITY), INFINITY));
     // Powers of ten and their neighbours (the decade boundaries).
     const double power = std::pow(10.0, int(random() % 40) - 15);
     check(power);

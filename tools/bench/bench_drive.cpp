@@ -1,7 +1,7 @@
 // Cost of the drive: simulated seconds per wall second for the seed-000 scenarios (firmware and
 // plant together), drive_sim's runs of the realistic scenario without output and with its CSV
-// (the plant's integrators and the CSV's formatting, each against the method it replaced, in
-// the same run), and the control tick alone (the plant does not advance while it is timed).
+// (the plant's integrators and the CSV's formatting methods, each against the one it replaced,
+// in the same run), and the control tick alone (the plant does not advance while it is timed).
 #include <benchmark/benchmark.h>
 
 #include <chrono>
@@ -95,20 +95,24 @@ void BM_DriveSim(benchmark::State& bench, const char* integrator, Output output,
       benchmark::Counter(s.duration_s * double(bench.iterations()), benchmark::Counter::kIsRate);
 }
 using imd::tools::CsvFormatting;
-BENCHMARK_CAPTURE(BM_DriveSim, before/no_output, "rk4", Output::none, CsvFormatting::buffered)
-    ->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(BM_DriveSim, after/no_output, "rk6", Output::none, CsvFormatting::buffered)
-    ->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(BM_DriveSim, before/csv, "rk4", Output::csv, CsvFormatting::fmt_per_row)
-    ->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(BM_DriveSim, after/csv, "rk6", Output::csv, CsvFormatting::buffered)
-    ->Unit(benchmark::kMillisecond);
-// Each change alone: the integrator with the old CSV, the CSV with the old integrator.
-BENCHMARK_CAPTURE(BM_DriveSim, rk6_fmt_per_row/csv, "rk6", Output::csv,
+// Wall time (UseRealTime): the threaded CSV's work is on a second thread.
+BENCHMARK_CAPTURE(BM_DriveSim, rk4/no_output, "rk4", Output::none, CsvFormatting::buffered)
+    ->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_DriveSim, rk6/no_output, "rk6", Output::none, CsvFormatting::buffered)
+    ->Unit(benchmark::kMillisecond)->UseRealTime();
+// The CSV's methods in turn, each with the integrator it ran with: fmt per row (RK4),
+// std::to_chars buffered (rk6), format_g10 buffered, and format_g10 on a second thread (what
+// drive_sim does).
+BENCHMARK_CAPTURE(BM_DriveSim, rk4_fmt_per_row/csv, "rk4", Output::csv,
                   CsvFormatting::fmt_per_row)
-    ->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(BM_DriveSim, rk4_buffered/csv, "rk4", Output::csv, CsvFormatting::buffered)
-    ->Unit(benchmark::kMillisecond);
+    ->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_DriveSim, rk6_to_chars/csv, "rk6", Output::csv,
+                  CsvFormatting::buffered_to_chars)
+    ->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_DriveSim, rk6_format_g10/csv, "rk6", Output::csv, CsvFormatting::buffered)
+    ->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_DriveSim, rk6_threaded/csv, "rk6", Output::csv, CsvFormatting::threaded)
+    ->Unit(benchmark::kMillisecond)->UseRealTime();
 
 /// The realistic drive, enabled and brought to the running state on the board; then each
 /// iteration is one period, and only the tick is timed (manual time: the plant advances between
@@ -169,8 +173,9 @@ BENCHMARK_TEMPLATE(BM_TickOnly, float)->Name("BM_TickOnly/float")->UseManualTime
 int main(int argc, char** argv) {
   return imd::bench::run_benchmarks(
       argc, argv,
-      {{"BM_DriveSim/before/no_output", "BM_DriveSim/after/no_output"},
-       {"BM_DriveSim/before/csv", "BM_DriveSim/after/csv"},
-       {"BM_DriveSim/before/csv", "BM_DriveSim/rk6_fmt_per_row/csv"},
-       {"BM_DriveSim/before/csv", "BM_DriveSim/rk4_buffered/csv"}});
+      {{"BM_DriveSim/rk4/no_output", "BM_DriveSim/rk6/no_output"},
+       {"BM_DriveSim/rk4_fmt_per_row/csv", "BM_DriveSim/rk6_to_chars/csv"},
+       {"BM_DriveSim/rk6_to_chars/csv", "BM_DriveSim/rk6_format_g10/csv"},
+       {"BM_DriveSim/rk6_to_chars/csv", "BM_DriveSim/rk6_threaded/csv"},
+       {"BM_DriveSim/rk6_to_chars/csv", "BM_DriveSim/rk6/no_output"}});
 }
