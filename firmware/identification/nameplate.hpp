@@ -2,6 +2,7 @@
 /// What a commissioning run starts from: the motor's nameplate, and the test levels, gains and
 /// times of the standstill identification derived from it and from the board by the rules of
 /// docs/identification.md. Construction only (double precision).
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
@@ -24,8 +25,9 @@ struct IdentificationPlan {
   double hf_voltage_V = 0.0;                ///< square-wave amplitude of the sigma Ls step
   double hf_ripple_A = 0.0;  ///< the ripple it aims at (the amplitude is cut to it once probed)
   int hf_half_period_ticks = 2;
-  int hf_ticks = 2000;        ///< length of the square-wave injection
-  int window_ticks = 100;     ///< the settling detector's averaging window (10 ms)
+  /// Times in ticks (plan_identification sets them from the period; these are 10 kHz's):
+  int hf_ticks = 2000;     ///< length of the square-wave injection (0.2 s)
+  int window_ticks = 100;  ///< the settling detector's averaging window (10 ms)
   double max_level_s = 60.0;  ///< a level that never settles fails the run
   double ramp_down_s = 0.05;  ///< current to zero at the end
 };
@@ -47,6 +49,8 @@ inline IdentificationPlan plan_identification(const Nameplate& n, double i_max_A
                                               double period_s) {
   IdentificationPlan p;
   p.period_s = period_s;
+  p.hf_ticks = std::max(1, static_cast<int>(std::lround(0.2 / period_s)));
+  p.window_ticks = std::max(1, static_cast<int>(std::lround(0.01 / period_s)));
   const double i_rated_peak_A = std::sqrt(2.0) * n.rated_current_A;
   // The square wave rides 0.2 I2 above the level: its peak stays within 0.9 of the limit.
   const double i_top_A = std::min(0.6 * i_rated_peak_A, 0.75 * i_max_A);

@@ -133,11 +133,10 @@ int run(const Options& o, const imd::sim::Scenario& s, imd::firmware::HilCan* ca
   config.commands_over_can = can != nullptr;
   config.auto_enable = can == nullptr;
   // Real time: the tick's execution time is real, so its budget is checked (the scenario's, or
-  // the firmware's default).
-  config.protection.tick_budget_ns =
-      s.protection.tick_budget_us
-          ? static_cast<uint32_t>(std::lround(*s.protection.tick_budget_us * 1e3))
-          : firmware::ProtectionConfig{}.tick_budget_ns;
+  // 90 % of the period: the firmware's default, 90 us, at 10 kHz).
+  config.protection.tick_budget_ns = static_cast<uint32_t>(std::lround(
+      s.protection.tick_budget_us ? *s.protection.tick_budget_us * 1e3
+                                  : 0.9 * s.sample_period_s * 1e9));
   config.enable_input_line = lines.enable;
   config.fault_output_line = lines.fault;
   config.timing_output_line = lines.timing;

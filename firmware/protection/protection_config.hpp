@@ -9,6 +9,17 @@
 
 namespace imd::firmware {
 
+/// The stuck-ADC check's window as a time: the evidence a window gathers is the voltage it
+/// sums times the period over sigma Ls, i.e. its volt-seconds, so a window of a fixed tick count
+/// would weaken with a shorter period. 2 ms is 20 ticks at 10 kHz.
+inline constexpr double kAdcStuckWindow_s = 2e-3;
+
+/// kAdcStuckWindow_s in ticks of `period_s`, rounded, at least the check's minimum of 2.
+constexpr int adc_stuck_ticks_for(double period_s) noexcept {
+  const double ticks = kAdcStuckWindow_s / period_s + 0.5;
+  return ticks < 2.0 ? 2 : (ticks > 1e6 ? 1'000'000 : static_cast<int>(ticks));
+}
+
 struct ProtectionConfig {
   /// The checks on the sensors themselves: off where the drive does not use them (ideal
   /// sensors in simulation give no encoder counts or ADC codes to judge).
@@ -29,7 +40,7 @@ struct ProtectionConfig {
   /// torque estimate's error (docs/safety.md).
   double encoder_max_load_share = 0.75;
   /// ADC stuck: ticks with identical phase codes while the applied voltage should have moved
-  /// the current by several codes.
+  /// the current by several codes. The default is adc_stuck_ticks_for(1e-4), 10 kHz's.
   int adc_stuck_ticks = 20;
   /// Phase loss (firmware/protection/phase_loss_check.hpp): the board's worst voltage error
   /// (dead time, device drops, bus ripple) as a share of the phase voltage range V_bus/sqrt(3),

@@ -76,7 +76,9 @@ firmware::DriveConfig drive_config(const Scenario& s) {
   p.overspeed_rad_s = set.overspeed_rad_s.value_or(p.overspeed_rad_s);
   p.encoder_missing_counts = set.encoder_missing_counts.value_or(p.encoder_missing_counts);
   p.encoder_max_load_share = set.encoder_max_load_share.value_or(p.encoder_max_load_share);
-  p.adc_stuck_ticks = set.adc_stuck_ticks.value_or(p.adc_stuck_ticks);
+  // The stuck-ADC window is a time (firmware/protection/protection_config.hpp).
+  p.adc_stuck_ticks =
+      set.adc_stuck_ticks.value_or(firmware::adc_stuck_ticks_for(s.sample_period_s));
   const double A_per_code = 2.0 * s.adc.full_scale_A / double(1 << s.adc.bits);
   p.inverter_voltage_error_share =
       set.inverter_voltage_error_share.value_or(p.inverter_voltage_error_share);

@@ -1,12 +1,14 @@
 /// Processor in the loop: the drive firmware on an emulated Cortex-M4F (QEMU mps2-an386)
-/// against the simulated board, compiled for the MCU too. The 10 kHz tick runs from SysTick in
-/// its two stages (hal/cortex_m/two_stage_tick.hpp): the sample stage latches the simulated
-/// sensors, the control stage runs Drive<float>. The timer is in lock-step: after each tick
-/// time stands still while the main loop advances the plant by one period (in double, which
-/// this FPU does not have, so it is far slower than real time) and fills the references ahead.
-/// The scenarios are compiled in (seed000_realistic_scenario.cpp, seed001_realistic_scenario.cpp);
-/// the emulator's command line chooses one and may change its law (pil_options.hpp). At the end
-/// the summary goes to the UART and the run ends through semihosting with the exit status:
+/// against the simulated board, compiled for the MCU too. The tick, at the scenario's period,
+/// runs from SysTick in its two stages (hal/cortex_m/two_stage_tick.hpp): the sample stage
+/// latches the simulated sensors, the control stage runs Drive<float>. The timer is in
+/// lock-step: after each tick time stands still while the main loop advances the plant by one
+/// period (in double, which this FPU does not have, so it is far slower than real time) and
+/// fills the references ahead. The scenarios are compiled in (seed000_realistic_scenario.cpp,
+/// seed001_realistic_scenario.cpp, and seed000_realistic_20kHz_scenario.cpp, the first at
+/// 20 kHz); the emulator's command line chooses one and may change its law (pil_options.hpp).
+/// At the end the summary goes to the UART and the run ends through semihosting with the exit
+/// status:
 ///   0 the run completed with no fault and no overrun, 1 it did not, 2 a bad command line,
 ///   3 a processor fault.
 #include <algorithm>
@@ -35,6 +37,7 @@ namespace imd::firmware {
 
 extern const sim::EmbeddedScenario kSeed000Realistic;
 extern const sim::EmbeddedScenario kSeed001Realistic;
+extern const sim::EmbeddedScenario kSeed000Realistic20kHz;
 
 namespace {
 
@@ -219,8 +222,9 @@ int main() {
   if (!hal::cortex_m::semihosting_command_line(command_line, sizeof command_line)) {
     command_line[0] = '\0';
   }
-  static const sim::EmbeddedScenario* const scenarios[] = {&firmware::kSeed000Realistic,
-                                                           &firmware::kSeed001Realistic};
+  static const sim::EmbeddedScenario* const scenarios[] = {
+      &firmware::kSeed000Realistic, &firmware::kSeed001Realistic,
+      &firmware::kSeed000Realistic20kHz};
   static firmware::PilOptions options = firmware::parse_pil_options(command_line, scenarios);
   if (options.error != nullptr) {
     console.write("pil error ");

@@ -130,7 +130,9 @@ constexpr DriveConfig drive_config() {
   p.bus_max_V = 400.0;                      // margin below the 450 V capacitors
   p.overspeed_rad_s = 400.0;
   p.command_timeout_s = 0.2;
-  p.tick_budget_ns = 80'000;  // 80 % of the period: the rest is sampling, CAN and margin
+  p.adc_stuck_ticks = adc_stuck_ticks_for(c.sample_period_s);
+  // 80 % of the period: the rest is sampling, CAN and margin.
+  p.tick_budget_ns = kControlPeriod_ns / 5 * 4;
   return c;
 }
 
