@@ -18,6 +18,14 @@ constexpr T dot_J(const Vec2<T>& a, const Vec2<T>& b) noexcept {
   return a.y() * b.x() - a.x() * b.y();
 }
 
+/// Whether every value is finite, in one test instead of one per value: x * 0 is zero for a
+/// finite x and NaN for an infinite or NaN one, and a sum of zeros is zero, so the sum is finite
+/// exactly when every value is.
+template <typename T, typename... Rest>
+bool all_finite(T first, Rest... rest) noexcept {
+  return std::isfinite(first * T(0) + (T(0) + ... + (rest * T(0))));
+}
+
 /// J x: the vector turned by +90 degrees.
 template <typename T>
 Vec2<T> J_times(const Vec2<T>& x) noexcept {

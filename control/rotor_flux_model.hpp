@@ -31,13 +31,18 @@ class RotorFluxModel {
   void reset(T flux_Wb, T angle_rad) noexcept {
     flux_Wb_ = flux_Wb;
     angle_rad_ = wrap_pi(angle_rad);
+    frame_ = Rotation<T>::from_angle(angle_rad_);
     slip_rad_s_ = T(0);
   }
 
-  /// The frame now: e^{angle J} takes flux-frame (d, q) vectors to the rotor frame.
-  Rotation<T> frame() const noexcept { return Rotation<T>::from_angle(angle_rad_); }
+  /// The frame now: e^{angle J} takes flux-frame (d, q) vectors to the rotor frame. Evaluated
+  /// once per change of the angle (in advance), so that the tick, which asks for it again after
+  /// the advance (frame_ahead(0) with one tick of latency) and before the next, pays for one
+  /// cosine and sine per period.
+  const Rotation<T>& frame() const noexcept { return frame_; }
   /// The frame `ticks` periods ahead at the present slip.
   Rotation<T> frame_ahead(int ticks) const noexcept {
+    if (ticks == 0) return frame_;
     return Rotation<T>::from_angle(angle_rad_ + T(ticks) * slip_rad_s_ * period_s_);
   }
 
@@ -46,6 +51,7 @@ class RotorFluxModel {
     const T flux = std::max(flux_Wb_, min_flux_Wb_);
     slip_rad_s_ = alpha_Lm_ * i_dq_A.y() / flux;
     angle_rad_ = wrap_pi(angle_rad_ + slip_rad_s_ * period_s_);
+    frame_ = Rotation<T>::from_angle(angle_rad_);
     flux_Wb_ = decay_ * flux_Wb_ + (T(1) - decay_) * Lm_ * i_dq_A.x();
   }
 
@@ -58,12 +64,14 @@ class RotorFluxModel {
   void continue_from(const RotorFluxModel& old) noexcept {
     flux_Wb_ = old.flux_Wb_;
     angle_rad_ = old.angle_rad_;
+    frame_ = old.frame_;
     slip_rad_s_ = old.slip_rad_s_;
   }
 
  private:
   T decay_, alpha_Lm_, Lm_, period_s_, min_flux_Wb_;
   T flux_Wb_ = T(0), angle_rad_ = T(0), slip_rad_s_ = T(0);
+  Rotation<T> frame_;  ///< of angle_rad_
 };
 
 }  // namespace imd::control

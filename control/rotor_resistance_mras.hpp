@@ -113,9 +113,7 @@ class RotorResistanceMras {
         pending_ = T(0);
       }
     }
-    if (!std::isfinite(q_ref_) || !std::isfinite(q_adapt_) || !std::isfinite(along_) ||
-        !std::isfinite(across_) || !std::isfinite(flux_AB_Wb_.x()) ||
-        !std::isfinite(flux_AB_Wb_.y())) {
+    if (!all_finite(q_ref_, q_adapt_, along_, across_, flux_AB_Wb_.x(), flux_AB_Wb_.y())) {
       reset_filters();  // a non-finite input must not stay in the filters
     }
     i_AB_last_A_ = i_AB_A;

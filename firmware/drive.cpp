@@ -65,6 +65,7 @@ void Drive<T>::on_tick() noexcept {
   const Measurement<T> m = sensing_.measure(supervisor_.state() == DriveState::calibrating);
   clock.lap(Stage::sense);
   MotorModel<T>* const model = this->model(k);
+  const Vec2 u_acted_V = u_last_period_V_;  // over [k-1, k]: the tracker's, after the write
   const Estimate<T> e = estimate(m, model);
   clock.lap(Stage::estimate);
   const TickPlan<T> plan = supervisor_.plan(k, m, e);
@@ -89,6 +90,7 @@ void Drive<T>::on_tick() noexcept {
   actuate(k, e, out, trip, model);
   check_budget(k, clock.lap_total(Stage::actuate), model);
   if (hw_.watchdog != nullptr) hw_.watchdog->feed();  // the PWM is written: the tick lives
+  after_write(m, e, u_acted_V, model);
   publish(k, m, e, plan, u, out, model);
   end_identification(k);
   if (bank_.apply_wanted()) release_model();
@@ -179,15 +181,34 @@ template <typename T>
 inline Estimate<T> Drive<T>::estimate(const Measurement<T>& m, MotorModel<T>* model) noexcept {
   // While the commissioning drives the motor the model's observers have nothing to follow.
   if (!m.valid || model == nullptr || supervisor_.state() == DriveState::identifying) return {};
-  StateEstimator<T>& estimator =
-      substitutes_.estimator != nullptr ? *substitutes_.estimator : model->observers;
-  Estimate<T> e = estimator.estimate(m);
+  // The board's own estimator is called as its final class: a direct call the compiler may
+  // inline, not a virtual one (likewise its power stage in modulate and actuate).
+  Estimate<T> e = substitutes_.estimator != nullptr ? substitutes_.estimator->estimate(m)
+                                                    : model->observers.estimate(m);
   model->predictor.set_input_state(e);
-  // The rotor resistance moves only while a law runs on a magnetized motor.
-  const bool adapt = tracking_ && supervisor_.state() == DriveState::running;
-  model->rotor_resistance.step(m.i_alphabeta_A, e.x.i_s_AB_A, e.x.omega_mech_rad_s,
-                               u_last_period_V_, adapt);
+  // The rotor resistance moves only while a law runs on a magnetized motor (decided now, on the
+  // state the estimate was made in; the tracker steps after the PWM write).
+  tracker_due_ = true;
+  tracker_adapts_ = tracking_ && supervisor_.state() == DriveState::running;
   return e;
+}
+
+template <typename T>
+inline void Drive<T>::after_write(const Measurement<T>& m, const Estimate<T>& e,
+                                  const Vec2& u_acted_V, MotorModel<T>* model) noexcept {
+  if (observers_due_) {  // the observers advance over [k, k+1] with the input acting on it
+    observers_due_ = false;
+    if (substitutes_.estimator != nullptr) {
+      substitutes_.estimator->advance(v_acting_V_);
+    } else {
+      model->observers.advance(v_acting_V_);
+    }
+  }
+  if (tracker_due_) {
+    tracker_due_ = false;
+    model->rotor_resistance.step(m.i_alphabeta_A, e.x.i_s_AB_A, e.x.omega_mech_rad_s, u_acted_V,
+                                 tracker_adapts_);
+  }
 }
 
 template <typename T>
@@ -223,9 +244,10 @@ inline Modulation<T> Drive<T>::modulate(const TickPlan<T>& plan, const LawOutput
   if (plan.mode == Mode::identifying) return identify(m);
   if (plan.mode == Mode::off || model == nullptr) return {};
   if (plan.mode == Mode::dc_braking) return dc_brake(m, e, *model);
-  PowerStage<T>& stage =
-      substitutes_.power_stage != nullptr ? *substitutes_.power_stage : model->svpwm;
-  return stage.modulate(u, e.x_input, m.v_bus_V);
+  if (substitutes_.power_stage != nullptr) {
+    return substitutes_.power_stage->modulate(u, e.x_input, m.v_bus_V);
+  }
+  return model->svpwm.modulate(u, e.x_input, m.v_bus_V);
 }
 
 template <typename T>
@@ -254,9 +276,11 @@ inline void Drive<T>::actuate(uint64_t k, const Estimate<T>& e, const Modulation
       u_applied_V = out.u_acting_alphabeta_V;
     }
   } else if (supervisor_.modulating() && model != nullptr) {
-    PowerStage<T>& stage =
-        substitutes_.power_stage != nullptr ? *substitutes_.power_stage : model->svpwm;
-    stage.write(out);
+    if (substitutes_.power_stage != nullptr) {
+      substitutes_.power_stage->write(out);
+    } else {
+      model->svpwm.write(out);
+    }
     u_written_V_ = out.u_alphabeta_V;
     v_applied_V_ = out.v_acting_AB_V;
     u_applied_V = out.u_acting_alphabeta_V;
@@ -265,11 +289,10 @@ inline void Drive<T>::actuate(uint64_t k, const Estimate<T>& e, const Modulation
     u_written_V_ = Vec2::Zero();
   }
   if (!hw_.pwm.enabled()) v_applied_V_ = u_applied_V = Vec2::Zero();
-  // The observers advance over [k, k+1] with the input acting on it.
+  // The input acting over [k, k+1], for the observers: they advance after the PWM write.
   if (e.valid && model != nullptr) {
-    StateEstimator<T>& estimator =
-        substitutes_.estimator != nullptr ? *substitutes_.estimator : model->observers;
-    estimator.advance(model->predictor.written(v_applied_V_));
+    v_acting_V_ = model->predictor.written(v_applied_V_);
+    observers_due_ = true;
     u_last_period_V_ = model->predictor.written_stator(u_applied_V);
   } else {
     u_last_period_V_ = Vec2::Zero();

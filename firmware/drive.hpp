@@ -6,7 +6,9 @@
 /// latency -> Estimate; supervise: commands and state transitions -> TickPlan; law: the
 /// magnetizing current or the selected control law -> LawOutput; modulate: inner feedback (2),
 /// limits, SVPWM -> Modulation; protect: every trip decision -> Trip; actuate: the PWM write,
-/// or the PWM off in the same tick as a trip; publish: the tick record and CAN telemetry.
+/// or the PWM off in the same tick as a trip; publish: the tick record and CAN telemetry. What
+/// the PWM write does not wait for runs after it, timed with publish: the observers advanced over
+/// the next period and the rotor-resistance tracker's step.
 /// Each stage is timed. T is the control arithmetic: float on the MCU, double on the host.
 #include <atomic>
 #include <cstdint>
@@ -143,6 +145,10 @@ class Drive final : public hal::TickHandler {
   /// The PWM write, or the PWM off with a fault latched; the observers learn what acts.
   [[gnu::always_inline]] void actuate(uint64_t k, const Estimate<T>& e, const Modulation<T>& out,
                                       const Trip& trip, MotorModel<T>* model) noexcept;
+  /// After the PWM write, what the write does not wait for: the observers advanced over the
+  /// next period, and the rotor-resistance tracker's step (it feeds only the service loop).
+  [[gnu::always_inline]] void after_write(const Measurement<T>& m, const Estimate<T>& e,
+                                          const Vec2& u_acted_V, MotorModel<T>* model) noexcept;
   /// The execution time up to the PWM write, against its budget.
   [[gnu::always_inline]] void check_budget(uint64_t k, uint32_t counts,
                                            MotorModel<T>* model) noexcept;
@@ -185,6 +191,11 @@ class Drive final : public hal::TickHandler {
   Vec2 u_written_V_ = Vec2::Zero();  ///< stator voltage applied over the last period
   Vec2 v_applied_V_ = Vec2::Zero();  ///< rotor-frame input written this tick (zero if off)
   Vec2 u_last_period_V_ = Vec2::Zero();  ///< stator voltage that acted over [k-1, k]
+  // Set before the PWM write for after_write (tick side).
+  Vec2 v_acting_V_ = Vec2::Zero();  ///< rotor-frame input acting over [k, k+1]
+  bool observers_due_ = false;      ///< the observers advance with it
+  bool tracker_due_ = false;        ///< the rotor-resistance tracker steps
+  bool tracker_adapts_ = false;     ///< and may move its estimate
   bool fault_line_level_ = false;
   bool brake_line_level_ = false;  ///< released (driven) or engaged
   uint64_t brake_released_tick_ = 0;  ///< when the line last released the brake

@@ -85,7 +85,7 @@ class DsmcLaw final : public ControlLaw<T> {
     // torque per volt (control/field_weakening.hpp, the IFOC's rule), with a tenth of the disk
     // left to the transients.
     const control::Vec2<T>& flux_AB = in.e.x_input.flux_r_AB_Wb;
-    const T flux_Wb = std::max(flux_AB.norm(), std::sqrt(min_flux2_));
+    const T flux_Wb = std::max(flux_AB.norm(), min_flux_Wb_);
     const T i_q = (flux_AB.x() * in.e.x_input.i_s_AB_A.y() -
                    flux_AB.y() * in.e.x_input.i_s_AB_A.x()) / flux_Wb;
     const T omega_e = p_ * in.e.x_input.omega_mech_rad_s + slip_per_A_ * i_q / flux_Wb;
@@ -132,6 +132,7 @@ class DsmcLaw final : public ControlLaw<T> {
   control::FieldWeakeningMotor<T> fw_motor_;
   T p_, slip_per_A_, min_flux2_;
   T flux2_rise_per_tick_;  ///< 2 delta / tau_r
+  T min_flux_Wb_ = std::sqrt(min_flux2_);  ///< once, not per tick (after min_flux2_)
   T flux2_limit_Wb2_ = std::numeric_limits<T>::infinity();  ///< field weakening's, last tick
 };
 

@@ -29,7 +29,9 @@ class AdcStuckCheck {
 
   /// `u_V`: the stator voltage applied over the last period (alpha-beta). True if stuck.
   bool stuck(const std::array<uint16_t, 3>& codes, const control::Vec2<T>& u_V) noexcept {
-    const bool repeated = started_ && codes == last_codes_;
+    // Element by element: std::array's == compares through a call of memcmp.
+    const bool repeated = started_ && codes[0] == last_codes_[0] && codes[1] == last_codes_[1] &&
+                          codes[2] == last_codes_[2];
     started_ = true;
     last_codes_ = codes;
     if (repeated) {

@@ -17,11 +17,6 @@ uint32_t saturated(uint64_t ticks) noexcept {
   return ticks < UINT32_MAX ? static_cast<uint32_t>(ticks) : UINT32_MAX;
 }
 
-template <typename T>
-bool finite(const control::Vec2<T>& v) noexcept {
-  return std::isfinite(v.x()) && std::isfinite(v.y());
-}
-
 /// The encoder check's configuration, with the estimates' quantization errors of the encoder
 /// observer the drive runs (construction only).
 template <typename T>
@@ -139,8 +134,8 @@ inline void Protection<T>::check_sensed(const Measurement<T>& m, const Estimate<
   }
   if (m.v_bus_V > bus_max_V_) trip.add(FaultCode::bus_overvoltage);
   if (std::abs(e.x.omega_mech_rad_s) > overspeed_rad_s_) trip.add(FaultCode::overspeed);
-  if (!finite(e.x.flux_r_AB_Wb) || !finite(e.x.i_s_AB_A) || !std::isfinite(e.x.omega_mech_rad_s) ||
-      !std::isfinite(e.load_Nm)) {
+  if (!control::all_finite(e.x.flux_r_AB_Wb.x(), e.x.flux_r_AB_Wb.y(), e.x.i_s_AB_A.x(),
+                           e.x.i_s_AB_A.y(), e.x.omega_mech_rad_s, e.load_Nm)) {
     trip.add(FaultCode::non_finite);
   }
   if (motor == nullptr) return;  // no motion model to judge the encoder by

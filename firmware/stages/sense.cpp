@@ -84,7 +84,14 @@ void BoardSensing<T>::read_encoder(Measurement<T>& m) noexcept {
   encoder_started_ = true;
   m.encoder_delta_counts = static_cast<int32_t>(count - last_encoder_count_);
   last_encoder_count_ = count;
-  encoder_position_ = ((encoder_position_ + m.encoder_delta_counts % cpr) % cpr + cpr) % cpr;
+  // The position is in [0, cpr) and the step's remainder in (-cpr, cpr): one correction by a
+  // revolution brings the sum back into [0, cpr), without two more divisions.
+  encoder_position_ += m.encoder_delta_counts % cpr;
+  if (encoder_position_ < 0) {
+    encoder_position_ += cpr;
+  } else if (encoder_position_ >= cpr) {
+    encoder_position_ -= cpr;
+  }
   m.theta_encoder_rad = T(2 * std::numbers::pi) * T(encoder_position_) / T(cpr);
 }
 

@@ -39,7 +39,8 @@ class SvpwmStage final : public PowerStage<T> {
       m.u_acting_alphabeta_V *= magnitude > limit ? limit / magnitude : T(1);
       m.v_acting_AB_V = rotation.apply_inverse(m.u_acting_alphabeta_V) - compensation;
     }
-    m.finite = finite(m.u_alphabeta_V) && finite(m.v_acting_AB_V);
+    m.finite = control::all_finite(m.u_alphabeta_V.x(), m.u_alphabeta_V.y(), m.v_acting_AB_V.x(),
+                                   m.v_acting_AB_V.y());
     m.duty = {float(pwm.duty[0]), float(pwm.duty[1]), float(pwm.duty[2])};
     if (dead_time_.active()) dead_time_.apply(m.duty, rotation.apply(x.i_s_AB_A), v_bus_V);
     return m;
@@ -51,10 +52,6 @@ class SvpwmStage final : public PowerStage<T> {
   }
 
  private:
-  static bool finite(const control::Vec2<T>& v) noexcept {
-    return std::isfinite(v.x()) && std::isfinite(v.y());
-  }
-
   hal::Pwm& pwm_;
   InnerFeedback<T> feedback_;
   DeadTimeCompensation<T> dead_time_;
