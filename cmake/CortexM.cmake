@@ -1,6 +1,7 @@
 # Firmware images for Cortex-M4F targets.
 #
-# imd_add_cortex_m_image(NAME LINKER_SCRIPT script [TICK_ROOTS sym...] SOURCES src... LIBRARIES lib...)
+# imd_add_cortex_m_image(NAME LINKER_SCRIPT script [TICK_ROOTS sym...] [NO_DOUBLE]
+#                        SOURCES src... LIBRARIES lib...)
 # links NAME.elf with the target's linker script and writes NAME.map, NAME.size.txt, and the
 # flashable NAME.bin (raw, from the first flash address) and NAME.hex (Intel HEX). The
 # link itself refuses exceptions: every throw entry point is wrapped (--wrap) and the wrappers
@@ -9,7 +10,7 @@
 # hal/cortex_m/no_heap.cpp says why it is named at all). With TICK_ROOTS,
 # tools/check_tick_path.py then follows the static call graph from those interrupt entries and
 # fails the build if the tick can reach double-precision soft-float, the allocator (or its
-# traps) or exceptions.
+# traps) or exceptions; with NO_DOUBLE, also if double-precision soft-float is linked at all.
 find_package(Python3 REQUIRED COMPONENTS Interpreter)
 
 set(IMD_NO_HEAP_NO_EXCEPTIONS_WRAPS
@@ -21,7 +22,7 @@ find_program(IMD_ARM_SIZE arm-none-eabi-size REQUIRED)
 find_program(IMD_ARM_OBJCOPY arm-none-eabi-objcopy REQUIRED)
 
 function(imd_add_cortex_m_image NAME)
-  cmake_parse_arguments(ARG "" "LINKER_SCRIPT" "TICK_ROOTS;SOURCES;LIBRARIES" ${ARGN})
+  cmake_parse_arguments(ARG "NO_DOUBLE" "LINKER_SCRIPT" "TICK_ROOTS;SOURCES;LIBRARIES" ${ARGN})
   add_executable(${NAME} ${ARG_SOURCES})
   set_target_properties(${NAME} PROPERTIES SUFFIX ".elf")
   target_link_libraries(${NAME} PRIVATE ${ARG_LIBRARIES} imd_hal_cortex_m imd_cortex_m_runtime)
@@ -54,6 +55,9 @@ function(imd_add_cortex_m_image NAME)
     foreach(root IN LISTS ARG_TICK_ROOTS)
       list(APPEND roots --root ${root})
     endforeach()
+    if(ARG_NO_DOUBLE)
+      list(APPEND roots --no-double-in-image)
+    endif()
     add_custom_command(TARGET ${NAME} POST_BUILD
       COMMAND ${Python3_EXECUTABLE} ${PROJECT_SOURCE_DIR}/tools/check_tick_path.py
               --objdump ${CMAKE_OBJDUMP} $<TARGET_FILE:${NAME}> ${roots}
@@ -79,4 +83,15 @@ function(imd_add_flash_target NAME IMAGE)
     USES_TERMINAL
     COMMENT "Flashing ${IMAGE} with openocd (${IMD_OPENOCD_INTERFACE}, ${IMD_OPENOCD_TARGET})"
     VERBATIM)
+endfunction()
+
+# imd_optimize_for_size(DIRECTORY dir SOURCES src...): compile these sources of the library in
+# dir with -Os on the MCU: code that runs in the main loop (the model build, the laws' designs,
+# the parameter record) or only while commissioning, never in a running drive's tick, which
+# stays -O2 (docs/performance.md, "Flash and RAM of the board image").
+function(imd_optimize_for_size)
+  cmake_parse_arguments(ARG "" "DIRECTORY" "SOURCES" ${ARGN})
+  list(TRANSFORM ARG_SOURCES PREPEND ${ARG_DIRECTORY}/)  # relative paths would name this dir's
+  set_source_files_properties(${ARG_SOURCES} DIRECTORY ${ARG_DIRECTORY}
+                              PROPERTIES COMPILE_OPTIONS "-Os")
 endfunction()

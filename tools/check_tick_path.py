@@ -2,6 +2,8 @@
 """Post-link check: code reachable from the tick's interrupt entries (--root) must not reach
 double-precision soft-float, the heap or the exception machinery (DEFAULT_DENY, --deny-regex).
 Exit status: 0 clean, 1 a denied function is reachable (one call chain each), 2 bad input.
+With --no-double-in-image, also 1 if double-precision soft-float is linked anywhere in the
+image, reachable from the tick or not (each such function is listed with its direct callers).
 
 Method: a static call graph of the linked ELF. Functions are the FUNC symbols of `objdump -t`
 (Thumb bit cleared; a function ends at its size or at the next function, so literal pools and
@@ -41,8 +43,8 @@ import sys
 
 import imd_version
 
-DEFAULT_DENY = [
-    r'^__aeabi_(d|f2d|i2d|ui2d|l2d|ul2d)',  # double soft-float, run-time ABI names
+DOUBLE_DENY = [
+    r'^__aeabi_(d|cd|f2d|i2d|ui2d|l2d|ul2d)',  # double soft-float, run-time ABI names
     r'^__(add|sub|mul|div|neg)df3$',
     r'^__(extendsfdf2|truncdfsf2|fix(uns)?dfsi|fix(uns)?dfdi|float(un)?sidf|float(un)?didf)$',
     r'^__(eq|ne|lt|le|gt|ge|unord)df2$',
@@ -50,6 +52,8 @@ DEFAULT_DENY = [
     r'|sqrt|cbrt|hypot|fmod|remainder|floor|ceil|round|trunc|lround|llround|lrint|llrint|rint'
     r'|nearbyint|modf|frexp|ldexp|scalbn|copysign|fabs|fmin|fmax|fdim|fma)$',  # double libm
     r'^__ieee754_(?!.*f$)', r'^__kernel_(sin|cos|tan|rem_pio2)$',  # newlib's double internals
+]
+DEFAULT_DENY = DOUBLE_DENY + [
     r'^_?(malloc|free|calloc|realloc|memalign|aligned_alloc)(_r)?$',  # heap
     r'^_(malloc|free|calloc|realloc)_r$',
     r'^_Zn[wa]', r'^_Zd[la]',  # operator new, new[], delete, delete[]
@@ -260,6 +264,8 @@ def main(argv=None):
                     help='data objects whose words take no address, besides known vector table '
                          'names, the object holding the entry point and those following it')
     ap.add_argument('--report', metavar='FILE', help='write the reachable functions and sizes')
+    ap.add_argument('--no-double-in-image', action='store_true',
+                    help='also fail if double-precision soft-float is linked anywhere')
     ap.add_argument('--objdump', default='arm-none-eabi-objdump')
     imd_version.add_argument(ap)
     args = ap.parse_args(argv)
@@ -329,7 +335,7 @@ def main(argv=None):
     bad = sorted((f.start for f in reached if f.start in forbidden), key=forbidden.get)
     if not bad:
         print(f'tick path clean: {counts}; no double soft-float, heap or exceptions')
-        return 0
+        return check_image_double(funcs) if args.no_double_in_image else 0
     print(f'tick path NOT clean: {len(bad)} forbidden function{"s" * (len(bad) > 1)} reachable '
           f'({counts}); one shortest call chain each:')
     hop = dict(call='', tail='(tail call) ', fall='(falls through) ', indirect='(indirect) ')
@@ -339,6 +345,34 @@ def main(argv=None):
             chain.append(hop[parent[node][1]] + name[node])
             node = parent[node][0]
         print(f'  {forbidden[start]}: ' + ' -> '.join([name[node]] + chain[::-1]))
+    if args.no_double_in_image:
+        check_image_double(funcs)
+    return 1
+
+
+def check_image_double(funcs):
+    """1 (and a list: each function with its direct callers) if any function of the image is
+    double-precision soft-float, else 0."""
+    double = [re.compile(r) for r in DOUBLE_DENY]
+    linked = {}  # start -> name shown; run-time ABI names (__aeabi_*) first, as above
+    for f in funcs.values():
+        for i in sorted(range(len(f.names)), key=lambda i: (f.names[i][:8] != '__aeabi_',
+                                                            f.names[i])):
+            if any(r.search(f.names[i]) for r in double):
+                linked[f.start] = f.label(i)
+                break
+    if not linked:
+        print(f'image free of double precision: none of {len(funcs)} functions')
+        return 0
+    callers = collections.defaultdict(set)
+    for f in funcs.values():
+        for target, _ in f.edges:
+            if target in linked and f.start not in linked:
+                callers[target].add(f.label())
+    print(f'image NOT free of double precision: {len(linked)} functions linked; with their '
+          'callers outside double code:')
+    for start in sorted(linked, key=linked.get):
+        print(f'  {linked[start]} <- {", ".join(sorted(callers[start])) or "(double code only)"}')
     return 1
 
 

@@ -40,12 +40,30 @@ TEST(SinCos, QuadrantBoundariesAndSigns) {
   }
 }
 
-TEST(SinCos, NonFiniteAndHugeAnglesFallBackToTheStandardLibrary) {
+TEST(SinCos, NonFiniteAnglesGiveNaN) {
   const float nan = std::numeric_limits<float>::quiet_NaN();
+  const float inf = std::numeric_limits<float>::infinity();
   EXPECT_TRUE(std::isnan(cos_sin(nan).cos));  // the drive's non_finite check sees it
-  EXPECT_TRUE(std::isnan(cos_sin(std::numeric_limits<float>::infinity()).sin));
-  EXPECT_EQ(cos_sin(1e6f).cos, std::cos(1e6f));
-  EXPECT_EQ(cos_sin(1e6f).sin, std::sin(1e6f));
+  EXPECT_TRUE(std::isnan(cos_sin(nan).sin));
+  EXPECT_TRUE(std::isnan(cos_sin(inf).sin));
+  EXPECT_TRUE(std::isnan(cos_sin(-inf).cos));
+}
+
+// Beyond 4096 rad the angle is reduced exactly modulo float(2 pi), which differs from 2 pi by
+// d = 1.7485e-7: k = |angle| / (2 pi) turns shift the angle by k d = |angle| * 2.783e-8 (taken
+// as 2.79e-8 to cover the rounding of k), then the reduced angle's own 2 ulp bound applies.
+TEST(SinCos, HugeAnglesStayWithinTheReductionBound) {
+  for (const float angle : {4096.5f, -5000.0f, 1e5f, -3.3e5f, 1e6f, 1.2345e7f}) {
+    const CosSin<float> cs = cos_sin(angle);
+    const double bound = std::abs(double(angle)) * 2.79e-8 + kBound;
+    EXPECT_NEAR(cs.cos, std::cos(double(angle)), bound) << angle;
+    EXPECT_NEAR(cs.sin, std::sin(double(angle)), bound) << angle;
+  }
+  // Where that bound exceeds 1 the result is still a point of the unit circle.
+  for (const float angle : {-8e9f, 3e20f, std::numeric_limits<float>::max()}) {
+    const CosSin<float> cs = cos_sin(angle);
+    EXPECT_NEAR(double(cs.cos) * cs.cos + double(cs.sin) * cs.sin, 1.0, 4 * kBound) << angle;
+  }
 }
 
 TEST(SinCos, DoubleIsTheStandardLibrarys) {
