@@ -143,7 +143,7 @@ control::Vec2<T> InertiaIdentifier<T>::step(const Vec2& i_A,
       if (step_ == InertiaStep::accelerate) {
         i_q_ref_A = i_q_A_;
         const bool at_speed = omega_block_rad_s_ >= omega_test_rad_s_;
-        if (ticks_ == max_accelerate_ticks_ / 2) omega_half_time_rad_s_ = omega_block_rad_s_;
+        if (ticks_ == max_accelerate_ticks_ / 2) half_time_counts_ = counts_;
         if (at_speed) {
           take_row(0);
           accelerate_ticks_ = ticks_;
@@ -156,7 +156,11 @@ control::Vec2<T> InertiaIdentifier<T>::step(const Vec2& i_A,
           // got far enough, else too heavy for the test.
           accelerate_ticks_ = ticks_;  // what the brake may take
           const bool moved = T(counts_) * rad_per_count_ > T(1);
-          const bool still_accelerating = omega_block_rad_s_ > T(1.5) * omega_half_time_rad_s_;
+          // Judged on the angle, which the encoder resolves in thousands of counts, not on the
+          // block speed, which a creeping rotor gives as one or two counts. From rest, the
+          // angle of the whole time over that of its first half is 4 at a constant
+          // acceleration and 2 at a settled speed: above 3, the rotor still accelerates.
+          const bool still_accelerating = counts_ > 3 * half_time_counts_;
           if (!moved) {
             stop(InertiaOutcome::no_motion);
           } else if (!still_accelerating) {

@@ -136,9 +136,9 @@ class InertiaIdentifier {
   int32_t block_counts_ = 0;
   uint32_t block_ticks_ = 0;
   T omega_block_rad_s_ = T(0), omega_brake_from_rad_s_ = T(0), omega_coast_from_rad_s_ = T(0);
-  T omega_half_time_rad_s_ = T(0);  ///< at half the acceleration's time limit
   // The integrals from rest: counts (exact), Int theta, Int Te, Int Int Te.
   int32_t counts_ = 0;
+  int32_t half_time_counts_ = 0;  ///< counts_ at half the acceleration's time limit
   CompensatedSum<T> int_theta_, int_torque_, int2_torque_;
   T row_theta_[2] = {}, row_int_theta_[2] = {}, row_int2_torque_[2] = {};
   Mechanics<T> result_;
