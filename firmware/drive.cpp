@@ -125,14 +125,9 @@ void Drive<T>::release_model() noexcept {
 
 template <typename T>
 Modulation<T> Drive<T>::identify(const Measurement<T>& m) noexcept {
-  Modulation<T> out;
-  if (!m.valid || !identifier_) return out;
-  out.u_alphabeta_V = identifier_->step(m.i_alphabeta_A, m.encoder_delta_counts);
-  const control::SvpwmResult<T> pwm = control::svpwm(out.u_alphabeta_V, m.v_bus_V);
-  for (int phase = 0; phase < 3; ++phase) out.duty[phase] = static_cast<float>(pwm.duty[phase]);
-  out.clipped = pwm.clipped;
-  out.finite = std::isfinite(out.u_alphabeta_V.x()) && std::isfinite(out.u_alphabeta_V.y());
-  out.direct = true;
+  if (!m.valid || !identifier_) return {};
+  const Modulation<T> out = direct_modulation(
+      identifier_->step(m.i_alphabeta_A, m.encoder_delta_counts), m.v_bus_V);
   supervisor_.identification_progress(identifier_->step_code(),
                                       static_cast<float>(identifier_->fraction()));
   return out;
@@ -141,13 +136,8 @@ Modulation<T> Drive<T>::identify(const Measurement<T>& m) noexcept {
 template <typename T>
 Modulation<T> Drive<T>::dc_brake(const Measurement<T>& m, const Estimate<T>& e,
                                  MotorModel<T>& model) noexcept {
-  Modulation<T> out;
-  out.u_alphabeta_V = model.dc_brake.step(m.i_alphabeta_A, model.limits.v_max_V(m.v_bus_V));
-  const control::SvpwmResult<T> pwm = control::svpwm(out.u_alphabeta_V, m.v_bus_V);
-  for (int phase = 0; phase < 3; ++phase) out.duty[phase] = static_cast<float>(pwm.duty[phase]);
-  out.clipped = pwm.clipped;
-  out.finite = std::isfinite(out.u_alphabeta_V.x()) && std::isfinite(out.u_alphabeta_V.y());
-  out.direct = true;
+  Modulation<T> out = direct_modulation(
+      model.dc_brake.step(m.i_alphabeta_A, model.limits.v_max_V(m.v_bus_V)), m.v_bus_V);
   // What acts, for the observers (their position is the failed encoder's: of no use now).
   out.u_acting_alphabeta_V = out.u_alphabeta_V;
   out.v_acting_AB_V =

@@ -5,7 +5,10 @@
 /// ideal current source (hal_sim/drive/) through the same interface. modulate() computes, and
 /// write() applies once protection has passed; the PWM's enable gates every power stage.
 /// Tick context.
+#include <cmath>
+
 #include "control/frames.hpp"
+#include "control/svpwm.hpp"
 #include "control/voltage_fed_model.hpp"
 #include "firmware/laws/control_law.hpp"
 #include "hal/pwm.hpp"
@@ -28,6 +31,19 @@ struct Modulation {
   bool direct = false;
   bool finite = true;    ///< false: a NaN or Inf on the way to the power stage
 };
+
+/// A voltage written as it is (the commissioning, DC braking): SVPWM only, no inner feedback.
+template <typename T>
+inline Modulation<T> direct_modulation(const control::Vec2<T>& u_alphabeta_V, T v_bus_V) noexcept {
+  Modulation<T> out;
+  out.u_alphabeta_V = u_alphabeta_V;
+  const control::SvpwmResult<T> pwm = control::svpwm(u_alphabeta_V, v_bus_V);
+  for (int phase = 0; phase < 3; ++phase) out.duty[phase] = static_cast<float>(pwm.duty[phase]);
+  out.clipped = pwm.clipped;
+  out.finite = std::isfinite(u_alphabeta_V.x()) && std::isfinite(u_alphabeta_V.y());
+  out.direct = true;
+  return out;
+}
 
 template <typename T>
 class PowerStage {

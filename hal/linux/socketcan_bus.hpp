@@ -62,7 +62,7 @@ class SocketCanBus final : public CanBus {
   bool try_receive(CanFrame& frame) noexcept override;
 
   /// The controller reported bus-off and has not restarted since.
-  bool bus_off() const noexcept { return errors_.bus_off; }
+  bool bus_off() const noexcept override { return errors_.bus_off; }
   const CanErrorState& errors() const noexcept { return errors_; }
   /// Received frames dropped because they are not classic 11-bit data frames.
   uint32_t unsupported_frames() const noexcept { return unsupported_frames_; }

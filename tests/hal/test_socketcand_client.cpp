@@ -130,6 +130,24 @@ TEST(SocketcandClient, KnowsWhenTheServerHasGone) {
   EXPECT_FALSE(client->try_send(frame_of(0x021, {})));
 }
 
+/// A socket listening on a free loopback port (returned in `port`) for one client; a
+/// `receive_buffer_bytes` above 0 sets its receive buffer (inherited by the accepted socket).
+int listen_on_loopback(uint16_t& port, int receive_buffer_bytes = 0) {
+  const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
+  if (receive_buffer_bytes > 0) {
+    ::setsockopt(fd, SOL_SOCKET, SO_RCVBUF, &receive_buffer_bytes, sizeof receive_buffer_bytes);
+  }
+  sockaddr_in address{};
+  address.sin_family = AF_INET;
+  address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  socklen_t length = sizeof address;
+  EXPECT_EQ(::bind(fd, reinterpret_cast<sockaddr*>(&address), length), 0);
+  EXPECT_EQ(::listen(fd, 1), 0);
+  ::getsockname(fd, reinterpret_cast<sockaddr*>(&address), &length);
+  port = ntohs(address.sin_port);
+  return fd;
+}
+
 /// A listening socket whose one client is written `text` one byte per send, with pauses, so
 /// that every message arrives cut into pieces.
 struct TricklingServer {
@@ -137,15 +155,7 @@ struct TricklingServer {
   uint16_t port = 0;
   std::thread thread;
   explicit TricklingServer(std::string text) {
-    listen_fd = ::socket(AF_INET, SOCK_STREAM, 0);
-    sockaddr_in address{};
-    address.sin_family = AF_INET;
-    address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-    socklen_t length = sizeof address;
-    EXPECT_EQ(::bind(listen_fd, reinterpret_cast<sockaddr*>(&address), length), 0);
-    EXPECT_EQ(::listen(listen_fd, 1), 0);
-    ::getsockname(listen_fd, reinterpret_cast<sockaddr*>(&address), &length);
-    port = ntohs(address.sin_port);
+    listen_fd = listen_on_loopback(port);
     thread = std::thread([this, text] {
       const int fd = ::accept(listen_fd, nullptr, nullptr);
       char answer[64];
@@ -175,17 +185,7 @@ struct BurstServer {
   std::atomic<bool> go{false}, drain{false}, done{false};
   std::thread thread;
   explicit BurstServer(std::string burst) {
-    listen_fd = ::socket(AF_INET, SOCK_STREAM, 0);
-    const int small_bytes = 4096;  // so that a client's unread sends soon fill TCP
-    ::setsockopt(listen_fd, SOL_SOCKET, SO_RCVBUF, &small_bytes, sizeof small_bytes);
-    sockaddr_in address{};
-    address.sin_family = AF_INET;
-    address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-    socklen_t length = sizeof address;
-    EXPECT_EQ(::bind(listen_fd, reinterpret_cast<sockaddr*>(&address), length), 0);
-    EXPECT_EQ(::listen(listen_fd, 1), 0);
-    ::getsockname(listen_fd, reinterpret_cast<sockaddr*>(&address), &length);
-    port = ntohs(address.sin_port);
+    listen_fd = listen_on_loopback(port, 4096);  // so that a client's unread sends soon fill TCP
     thread = std::thread([this, burst] {
       const int fd = ::accept(listen_fd, nullptr, nullptr);
       char bytes[4096];
