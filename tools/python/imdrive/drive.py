@@ -58,7 +58,10 @@ class Drive(ParameterService):
         self._changed = threading.Condition()  # the lock of everything the threads share
         self._learning = threading.Lock()  # one thread learns the counter at a time
         self._sending = threading.Lock()  # encode and send as one step: frames in counter order
-        self._waiting = {}  # (message id, counter) -> command_ack frame or None
+        # (message id, counter) -> the slot ([command_ack frame or None]) of the command that
+        # waits for it. Each send has its own slot: the counter wraps at 16, and a sender
+        # starved after its ack came must still find its ack once another sender reuses the key.
+        self._waiting = {}
         self._samples = collections.deque(maxlen=self.SAMPLE_QUEUE)
         self._frames = collections.deque(maxlen=self.SAMPLE_QUEUE)
         self._frame_seq = 0
@@ -120,8 +123,9 @@ class Drive(ParameterService):
             self._heartbeats += 1
         elif name == "command_ack":
             key = (_raw_message_id(frame), frame.counter)
-            if key in self._waiting and self._waiting[key] is None:
-                self._waiting[key] = frame
+            slot = self._waiting.pop(key, None)
+            if slot is not None:
+                slot[0] = frame
             else:
                 self.keep_alive.on_ack(frame)
 
@@ -287,25 +291,31 @@ class Drive(ParameterService):
                 return False
             frame = self._encoder.encode(message_name, **values)
             key = (table.message_id_of(frame.arbitration_id), frame.data[1] & 0x0F)
+            slot = [None]
             with self._changed:
-                self._waiting[key] = None
+                self._waiting[key] = slot
             try:
                 self.bus.send(frame)
             except can.CanError as error:
                 with self._changed:
-                    self._waiting.pop(key, None)
+                    self._forget_slot(key, slot)
                 raise DriveError(
                     f"node {self.node_id}: cannot send {message_name}: {error}") from None
         if not wait_ack:
             with self._changed:
-                self._waiting.pop(key, None)
+                self._forget_slot(key, slot)
             return None
         try:
-            return self.wait(lambda: self._waiting[key], self.answer_timeout_s,
+            return self.wait(lambda: slot[0], self.answer_timeout_s,
                              f"no command_ack for {message_name} (counter {key[1]})")
         finally:
             with self._changed:
-                self._waiting.pop(key, None)
+                self._forget_slot(key, slot)
+
+    def _forget_slot(self, key, slot):
+        """Stops waiting on `slot` unless a later command with the same key holds `key` now."""
+        if self._waiting.get(key) is slot:
+            del self._waiting[key]
 
     def enable(self, keep_alive=True, calibration_timeout_s=5.0):
         """idle -> magnetizing -> running; starts the keep-alive (set_speed 0 until set_speed).
