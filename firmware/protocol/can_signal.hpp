@@ -8,7 +8,24 @@
 #include <cstdint>
 #include <span>
 
+/// Whether the tables keep their documentation text (units and comments, which the DBC and the
+/// protocol page are written from). The bare-metal images build with 0: nothing on the board
+/// reads that text, and it is most of the tables' flash.
+#ifndef IMD_PROTOCOL_DOC_TEXT
+#define IMD_PROTOCOL_DOC_TEXT 1
+#endif
+
 namespace imd::firmware::protocol {
+
+#if IMD_PROTOCOL_DOC_TEXT
+using DocText = const char*;
+#else
+/// Takes a string literal and keeps none of it: the literal is not emitted, and with
+/// [[no_unique_address]] the member takes no room. Reading it fails to compile.
+struct DocText {
+  consteval DocText(const char*) noexcept {}  // NOLINT(google-explicit-constructor): literals
+};
+#endif
 
 /// A named raw value of an enumerated signal (a DBC VAL_ entry).
 struct ValueName {
@@ -24,8 +41,8 @@ struct Signal {
   int32_t scale_num = 1;
   int32_t scale_den = 1;
   float offset = 0.0f;
-  const char* unit = "";
-  const char* comment = "";
+  [[no_unique_address]] DocText unit = "";
+  [[no_unique_address]] DocText comment = "";
   std::span<const ValueName> values = {};
   /// An IEEE 754 single-precision value in 32 bits (a DBC SIG_VALTYPE_ 1 signal); the scale is
   /// 1 and the offset 0.
