@@ -9,7 +9,8 @@
 namespace imd::sim {
 
 /// Nanoseconds since an arbitrary origin; never decreases. Tick context: must be cheap and
-/// must not block.
+/// must not block, once it has been read a first time outside a tick (an implementation may
+/// calibrate itself then; SimTimer's constructor does that read).
 uint64_t host_clock_ns() noexcept;
 
 }  // namespace imd::sim

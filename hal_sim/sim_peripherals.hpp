@@ -11,6 +11,7 @@
 #include "hal/encoder.hpp"
 #include "hal/gpio.hpp"
 #include "hal/pwm.hpp"
+#include "hal_sim/host_clock.hpp"
 
 namespace imd::sim {
 
@@ -135,7 +136,9 @@ class SimGpio final : public hal::Gpio {
 /// overrun fault) has stolen.
 class SimTimer final : public hal::ControlTimer {
  public:
-  explicit SimTimer(uint32_t period_ns) : period_ns_(period_ns) {}
+  /// Reads the host clock once: its first read calibrates it (host_clock_linux.cpp), which
+  /// must happen here and not in a tick.
+  explicit SimTimer(uint32_t period_ns) : period_ns_(period_ns) { (void)host_clock_ns(); }
   void start(hal::TickHandler& handler) noexcept override { handler_ = &handler; }
   void stop() noexcept override { handler_ = nullptr; }
   uint32_t period_ns() const noexcept override { return period_ns_; }

@@ -1,11 +1,15 @@
 // Cost of the continuous plant: one right-hand-side evaluation of model (1), and one period
 // step (10 kHz period) in each of the plant's three input modes: RK4 for several substep counts,
 // and RK4 at 10 substeps against the sixth-order integrator (hal_sim/plant_integrator.hpp) at
-// several speeds (its step count grows with the speed), their ratio printed at the end.
+// several speeds (its step count grows with the speed), their ratio printed at the end. And the
+// simulated board's execution clock (hal_sim/host_clock.hpp), read two to four times a tick,
+// against the steady_clock it replaced.
 #include <benchmark/benchmark.h>
 
+#include <chrono>
 #include <cmath>
 
+#include "hal_sim/host_clock.hpp"
 #include "hal_sim/induction_motor_plant.hpp"
 #include "tools/bench/bench_main.hpp"
 
@@ -94,9 +98,39 @@ IMD_PLANT_INTEGRATOR(1, "analog_feedback");
 IMD_PLANT_INTEGRATOR(2, "current_fed");
 #undef IMD_PLANT_INTEGRATOR
 
+/// One read of a clock; fails if it went backwards or stood still over the whole run.
+template <typename Read>
+void read_clock(benchmark::State& bench, Read read) {
+  const uint64_t first = read();
+  uint64_t last = first;
+  bool backwards = false;
+  for (auto _ : bench) {
+    const uint64_t now = read();
+    backwards |= now < last;
+    last = now;
+    benchmark::DoNotOptimize(last);
+  }
+  if (backwards) bench.SkipWithError("the clock went backwards");
+  if (last == first) bench.SkipWithError("the clock did not move");
+}
+void BM_Clock_steady(benchmark::State& bench) {
+  read_clock(bench, [] {
+    return uint64_t(std::chrono::duration_cast<std::chrono::nanoseconds>(
+                        std::chrono::steady_clock::now().time_since_epoch())
+                        .count());
+  });
+}
+BENCHMARK(BM_Clock_steady);
+void BM_Clock_host_clock_ns(benchmark::State& bench) {
+  read_clock(bench, [] { return imd::sim::host_clock_ns(); });
+}
+BENCHMARK(BM_Clock_host_clock_ns);
+
 }  // namespace
 
 int main(int argc, char** argv) {
-  return imd::bench::run_benchmarks(argc, argv,
-                                    {{"BM_PlantIntegrator/rk4/", "BM_PlantIntegrator/rk6/"}});
+  return imd::bench::run_benchmarks(
+      argc, argv,
+      {{"BM_PlantIntegrator/rk4/", "BM_PlantIntegrator/rk6/"},
+       {"BM_Clock_steady", "BM_Clock_host_clock_ns"}});
 }
