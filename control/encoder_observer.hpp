@@ -11,8 +11,8 @@
 /// exp(-bandwidth delta) (Ackermann). The angle is kept in [0, 2 pi) so that float keeps its
 /// resolution. Tick context except the constructor.
 #include <Eigen/Core>
-#include <Eigen/LU>
 #include <cmath>
+#include <limits>
 #include <numbers>
 
 #include "control/voltage_fed_model.hpp"
@@ -24,28 +24,44 @@ struct EncoderObserverConfig {
   double bandwidth_rad_s = 400.0;  ///< the three error poles sit at exp(-bandwidth delta)
 };
 
-/// Observer gain L for the mechanical model of `c` (Ackermann on the pair (A, C A)).
-inline Eigen::Vector3d place_encoder_observer(const VoltageFedCoefficients& c,
-                                              double bandwidth_rad_s) {
-  Eigen::Matrix3d a;
-  a << 1.0, c.omega_to_theta_s, c.load_to_theta,  //
-      0.0, c.omega_decay, c.load_to_omega,        //
-      0.0, 0.0, 1.0;
-  const Eigen::RowVector3d ca = Eigen::RowVector3d(1.0, 0.0, 0.0) * a;
-  Eigen::Matrix3d observability;
-  observability << ca, ca * a, ca * a * a;
-  const double z = std::exp(-bandwidth_rad_s * c.delta_s);
-  const Eigen::Matrix3d shifted = a - z * Eigen::Matrix3d::Identity();
-  const Eigen::Matrix3d phi = shifted * shifted * shifted;  // (A - z I)^3
-  return phi * observability.inverse() * Eigen::Vector3d(0.0, 0.0, 1.0);
+/// Observer gain L for the mechanical model of `c`: the three poles of A - L C A at
+/// p = exp(-bandwidth delta). A = [1 t l; 0 1+e g; 0 0 1] (t = omega_to_theta, l =
+/// load_to_theta, e = omega_decay - 1, g = load_to_omega); matching det(zI - A + L C A) to
+/// (z - p)^3 is linear in L, and its solution, with s = 1 - p and D = g t - e l, is
+///   L1 = (e + 3s - 3s^2 + s^3) / (1 + e)
+///   L2 = (g t (e^2 + 3 e s + 3 s^2 - s^3) - l (e + s)^3) / (t (1 + e) D)
+///   L3 = s^3 / D
+/// (docs/derivations.md, "The encoder observer's gain"). In closed form rather than by
+/// Ackermann's formula: the observability matrix [CA; CA^2; CA^3] has rows that differ in
+/// their O(delta) terms (condition 1e6 to 7e8 on the test motors), so its inverse loses six to
+/// nine digits, all of float's. These expressions hold a few roundings in float as in double:
+/// g t and -e l share a sign (e <= 0, g and l < 0, t > 0), and the numerators cancel only as
+/// e + s does, delta (bandwidth - c/J) to first order: by a factor bandwidth / (bandwidth - c/J),
+/// 1.33 for a mechanical pole c/J as fast as 100 rad/s under a 400 rad/s observer.
+template <typename T = double>
+Eigen::Matrix<T, 3, 1> place_encoder_observer(const VoltageFedCoefficients& c,
+                                              T bandwidth_rad_s) noexcept {
+  const T t = T(c.omega_to_theta_s), l = T(c.load_to_theta);
+  const T e = T(c.omega_decay_minus_one), g = T(c.load_to_omega);
+  const T s = -std::expm1(-bandwidth_rad_s * T(c.delta_s));  // 1 - p without cancellation
+  const T s2 = s * s, s3 = s2 * s, es = e + s;
+  const T d = g * t - e * l;
+  const T one_plus_e = T(1) + e;
+  return {(e + T(3) * s - T(3) * s2 + s3) / one_plus_e,
+          (g * t * (e * e + T(3) * e * s + T(3) * s2 - s3) - l * es * es * es) /
+              (t * one_plus_e * d),
+          s3 / d};
 }
 
 /// The error matrix A - L C A of the observer, for checks.
-inline Eigen::Matrix3d encoder_observer_error_matrix(const VoltageFedCoefficients& c,
-                                                     const Eigen::Vector3d& gain) {
-  Eigen::Matrix3d a;
-  a << 1.0, c.omega_to_theta_s, c.load_to_theta, 0.0, c.omega_decay, c.load_to_omega, 0.0, 0.0, 1.0;
-  return a - gain * (Eigen::RowVector3d(1.0, 0.0, 0.0) * a);
+template <typename T = double>
+Eigen::Matrix<T, 3, 3> encoder_observer_error_matrix(const VoltageFedCoefficients& c,
+                                                     const Eigen::Matrix<T, 3, 1>& gain) noexcept {
+  Eigen::Matrix<T, 3, 3> a;
+  a << T(1), T(c.omega_to_theta_s), T(c.load_to_theta),  //
+      T(0), T(c.omega_decay), T(c.load_to_omega),        //
+      T(0), T(0), T(1);
+  return a - gain * a.row(0);  // C A is A's first row
 }
 
 /// fmod(x, 2 pi), out of line: wrap_pi's path for angles beyond two turns, which the tick never
@@ -79,21 +95,26 @@ struct QuantizationErrorBounds {
   double omega_rad_s = 0.0;
   double load_Nm = 0.0;
 };
-inline QuantizationErrorBounds encoder_quantization_bounds(const VoltageFedCoefficients& c,
-                                                           double bandwidth_rad_s, double q_rad) {
-  Eigen::Vector3d response = place_encoder_observer(c, bandwidth_rad_s);
-  const Eigen::Matrix3d error = encoder_observer_error_matrix(c, response);
-  QuantizationErrorBounds b;
+/// Computed in T: on the MCU in float, where a few thousand 3x3 steps cost tens of thousands of
+/// instructions rather than millions in soft double. The n steps' rounding moves the sums by
+/// about 3 n u relative (u = epsilon / 2); the results are raised by twice that, 3 n epsilon
+/// (5.7e-4 at 10 kHz, 1.1e-3 at 20 kHz in float), so that they stay bounds. Measured, the float
+/// sums are within 3e-6 of the double ones (tests/control/test_encoder_observer_gain.cpp).
+template <typename T = double>
+QuantizationErrorBounds encoder_quantization_bounds(const VoltageFedCoefficients& c,
+                                                    T bandwidth_rad_s, T q_rad) noexcept {
+  Eigen::Matrix<T, 3, 1> response = place_encoder_observer<T>(c, bandwidth_rad_s);
+  const Eigen::Matrix<T, 3, 3> error = encoder_observer_error_matrix<T>(c, response);
+  T omega = T(0), load = T(0);
   // The triple pole z = e^{-bandwidth delta} decays as k^2 z^k: 60 time constants leave 1e-20.
-  const int terms = static_cast<int>(60.0 / (bandwidth_rad_s * c.delta_s)) + 100;
+  const int terms = static_cast<int>(T(60) / (bandwidth_rad_s * T(c.delta_s))) + 100;
   for (int j = 0; j < terms; ++j) {
-    b.omega_rad_s += std::abs(response(1));
-    b.load_Nm += std::abs(response(2));
+    omega += std::abs(response(1));
+    load += std::abs(response(2));
     response = error * response;
   }
-  b.omega_rad_s *= q_rad;
-  b.load_Nm *= q_rad;
-  return b;
+  const T rounding = T(1) + T(3 * terms) * std::numeric_limits<T>::epsilon();
+  return {double(omega * q_rad * rounding), double(load * q_rad * rounding)};
 }
 
 template <typename T>
@@ -110,10 +131,10 @@ class EncoderObserver {
         kappa1_(T(c.kappa1)),
         kappa2_(T(c.kappa2)),
         kappa3_(T(c.kappa3)) {
-    const Eigen::Vector3d l = place_encoder_observer(c, config.bandwidth_rad_s);
-    gain_theta_ = T(l(0));
-    gain_omega_ = T(l(1));
-    gain_load_ = T(l(2));
+    const Eigen::Matrix<T, 3, 1> l = place_encoder_observer<T>(c, T(config.bandwidth_rad_s));
+    gain_theta_ = l(0);
+    gain_omega_ = l(1);
+    gain_load_ = l(2);
   }
 
   T theta_mech_rad() const noexcept { return theta_; }  ///< in [0, 2 pi)
