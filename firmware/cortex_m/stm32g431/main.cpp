@@ -49,6 +49,23 @@ volatile cm::FatalFault g_fatal_fault = cm::FatalFault::nmi;
   stop_in_safe_state();
 }
 
+/// The drive, built once from the motor record in the parameter pages (the newest whole copy;
+/// without one the drive stays unconfigured, as its heartbeat says, until a record is written
+/// over CAN). It follows its own CAN-commanded references (commands_over_can). Out of line:
+/// the record, its decoded parameters and the configuration are temporaries of the
+/// construction, about 700 B, which in main() would stay on the stack under every model
+/// rebuild of the main loop, with the tick's interrupts on top.
+[[gnu::noinline]] firmware::Drive<float>& build_drive(
+    hal::PagePairStore<firmware::kMotorRecordBytes>& store,
+    const firmware::DrivePeripherals& peripherals) noexcept {
+  std::array<uint8_t, firmware::kMotorRecordBytes> record{};
+  const std::size_t record_bytes = store.load(record);
+  static firmware::Drive<float> drive(
+      firmware::decode_motor_record(std::span<const uint8_t>(record).first(record_bytes)),
+      drive_config(), peripherals);
+  return drive;
+}
+
 }  // namespace
 }  // namespace imd::firmware::stm32g431
 
@@ -85,20 +102,14 @@ int main() {
   if (!can.ok()) halt(BootFailure::can);
   static g4::AdcEncoderSample sample(adc, encoder);
   static g4::AdcTick tick(kTick, adc, sample);
-  // The motor record from the parameter pages: the newest whole copy. Without one the drive
-  // stays unconfigured (its heartbeat says so) until a record is written over CAN.
   static g4::FlashPagePair flash;
   static hal::PagePairStore<firmware::kMotorRecordBytes> store(flash);
-  std::array<uint8_t, firmware::kMotorRecordBytes> record{};
-  const std::size_t record_bytes = store.load(record);
   // The independent watchdog, fed by the control stage only, started once the ticks run (the
   // drive's construction builds the motor model, about 12 ms).
   const hal::ResetCause reset_cause = g4::take_reset_cause();
   static g4::Iwdg watchdog;
-  // The drive follows its own CAN-commanded references (commands_over_can).
-  static firmware::Drive<float> drive(
-      firmware::decode_motor_record(std::span<const uint8_t>(record).first(record_bytes)),
-      drive_config(), {pwm, encoder, adc, tick, &can, &gpio, &store, &watchdog, reset_cause});
+  firmware::Drive<float>& drive =
+      build_drive(store, {pwm, encoder, adc, tick, &can, &gpio, &store, &watchdog, reset_cause});
 
   // The carrier (and with it the ADC trigger) starts; the update event must be the peak.
   if (!pwm.start()) halt(BootFailure::pwm_phase);
