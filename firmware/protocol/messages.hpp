@@ -81,7 +81,7 @@ struct Message {
   Direction direction;
   Timing timing;
   uint16_t period_ms;  ///< cyclic and configurable messages
-  [[no_unique_address]] DocText comment;
+  [[no_unique_address]] DocText comment = "";
   std::span<const Signal> signals;
 
   constexpr bool e2e() const noexcept { return direction == Direction::host_to_drive; }

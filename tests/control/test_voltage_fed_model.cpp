@@ -173,7 +173,8 @@ TEST(VoltageFedModel, CoefficientsMatchQuadratureOfTheMinors) {
     const double signs[3] = {1.0, -1.0, -1.0};
     const double eta[3] = {c.eta1, c.eta2, c.eta3}, kappa[3] = {c.kappa1, c.kappa2, c.kappa3};
     for (int i = 0; i < 3; ++i) {
-      const auto [j, l] = pairs[i];
+      const int j = pairs[i][0], l = pairs[i][1];  // not a structured binding: clang 14 cannot
+                                                    // capture one in a lambda
       const double eta_q =
           signs[i] * mu *
           simpson([&](double u) { return minor(u, j, l) * speed_weight(u); }, kDelta_s, 1600);

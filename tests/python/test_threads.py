@@ -62,6 +62,7 @@ def test_a_sender_starved_past_a_counter_wrap_still_gets_its_own_ack(fake_and_bu
         deadline = time.monotonic() + 5.0
         while not fake.received and time.monotonic() < deadline:
             time.sleep(0.001)  # its ack has come: the case is the one of a sender not woken
+        assert fake.received, "the held sender's command was never answered"
         first_counter = fake.arrivals[0][2]
         for _ in range(16):  # the 16th takes the starved command's counter again
             drive.clear_faults()

@@ -71,7 +71,6 @@ class SoakHost {
   const char* expected_code_ = "";
   double repair_at_s_ = 0.0;
   bool repaired_ = true;
-  bool enable_after_disable_ = false;
   double enable_at_s_ = 0.0;
   double t_s_ = 0.0;
 };

@@ -292,8 +292,9 @@ class Drive(ParameterService):
             frame = self._encoder.encode(message_name, **values)
             key = (table.message_id_of(frame.arbitration_id), frame.data[1] & 0x0F)
             slot = [None]
-            with self._changed:
-                self._waiting[key] = slot
+            if wait_ack:  # else its ack goes to the keep-alive (on_ack), not to a slot
+                with self._changed:
+                    self._waiting[key] = slot
             try:
                 self.bus.send(frame)
             except can.CanError as error:
@@ -302,8 +303,6 @@ class Drive(ParameterService):
                 raise DriveError(
                     f"node {self.node_id}: cannot send {message_name}: {error}") from None
         if not wait_ack:
-            with self._changed:
-                self._forget_slot(key, slot)
             return None
         try:
             return self.wait(lambda: slot[0], self.answer_timeout_s,
