@@ -24,7 +24,7 @@ typename EncoderCheck<T>::Config encoder_config(const control::MotorParameters& 
                                                 const control::VoltageFedCoefficients& c,
                                                 const DriveConfig& config, double counts_per_rev) {
   // In the drive's arithmetic: on the MCU the bound's few thousand steps are float, not soft
-  // double (control/encoder_observer.hpp keeps it a bound).
+  // double (control/encoder_observer.hpp raises the float result by a rounding margin).
   const control::QuantizationErrorBounds q = control::encoder_quantization_bounds<T>(
       c, T(config.encoder_observer_bandwidth_rad_s), T(2.0 * std::numbers::pi / counts_per_rev));
   return {counts_per_rev,
