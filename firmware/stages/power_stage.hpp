@@ -40,7 +40,7 @@ inline Modulation<T> direct_modulation(const control::Vec2<T>& u_alphabeta_V, T 
   const control::SvpwmResult<T> pwm = control::svpwm(u_alphabeta_V, v_bus_V);
   for (int phase = 0; phase < 3; ++phase) out.duty[phase] = static_cast<float>(pwm.duty[phase]);
   out.clipped = pwm.clipped;
-  out.finite = std::isfinite(u_alphabeta_V.x()) && std::isfinite(u_alphabeta_V.y());
+  out.finite = control::all_finite(u_alphabeta_V.x(), u_alphabeta_V.y());
   out.direct = true;
   return out;
 }

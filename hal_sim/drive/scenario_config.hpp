@@ -6,6 +6,7 @@
 
 #include "firmware/drive_config.hpp"
 #include "firmware/reference_source.hpp"
+#include "hal_sim/drive/lookahead_references.hpp"
 #include "hal_sim/drive/scenario_profiles.hpp"
 #include "hal_sim/scenario.hpp"
 #include "hal_sim/sim_board.hpp"
@@ -43,7 +44,9 @@ class ScenarioReferences final : public firmware::ReferenceSource<T> {
   }
 
  private:
-  static constexpr uint64_t kKept = 4;
+  // As deep as the drive looks ahead (the current-fed law a whole T0): fewer slots would
+  // evict k + 1 and k + 2 each tick to make room for the look-ahead.
+  static constexpr uint64_t kKept = LookaheadReferences<T>::kDepth;
   struct Kept {
     bool valid = false;
     uint64_t k = 0;

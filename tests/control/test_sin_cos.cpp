@@ -59,7 +59,9 @@ TEST(SinCos, HugeAnglesStayWithinTheReductionBound) {
     EXPECT_NEAR(cs.cos, std::cos(double(angle)), bound) << angle;
     EXPECT_NEAR(cs.sin, std::sin(double(angle)), bound) << angle;
   }
-  // Where that bound exceeds 1 the result is still a point of the unit circle.
+  // Where that bound exceeds 1 the result is still a point of the unit circle: cos and sin of
+  // the reduced angle are each within kBound, so c^2 + s^2 is within 2 (|c| + |s|) kBound
+  // <= 2 sqrt(2) kBound of 1, plus its own rounding; 4 kBound holds both.
   for (const float angle : {-8e9f, 3e20f, std::numeric_limits<float>::max()}) {
     const CosSin<float> cs = cos_sin(angle);
     EXPECT_NEAR(double(cs.cos) * cs.cos + double(cs.sin) * cs.sin, 1.0, 4 * kBound) << angle;

@@ -103,8 +103,13 @@ TEST(DriveAt20kHz, TracksOnEveryMotorAtLeastAsWellAsAt10kHz) {
     std::vector<double> speed[2], flux[2];
     for (int rate = 0; rate < 2; ++rate) {
       for (unsigned seed = 1; seed <= kSeeds; ++seed) {
-        const Summary r = run_scenario(offset_sine(m, rate == 0 ? k10kHz_s : k20kHz_s, seed));
+        const Scenario s = offset_sine(m, rate == 0 ? k10kHz_s : k20kHz_s, seed);
+        const Summary r = run_scenario(s);
         EXPECT_TRUE(r.faults.empty()) << m.file << (rate ? " at 20 kHz" : " at 10 kHz");
+        // It ran at the rate asked: the two rates' errors alike could also mean the period
+        // override was lost.
+        EXPECT_EQ(r.ticks, uint64_t(std::llround(s.duration_s / (rate == 0 ? k10kHz_s : k20kHz_s))))
+            << m.file;
         // Running, and at the offset before the measured span (its ramp takes 0.15 s at most).
         EXPECT_GE(r.running_from_s, 0.0) << m.file;
         EXPECT_LT(r.running_from_s, m.running_s + 0.25) << m.file;

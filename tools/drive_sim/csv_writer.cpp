@@ -101,17 +101,15 @@ void CsvWriter::row(const sim::SimRow& r) {
 }
 
 void CsvWriter::format(const sim::SimRow& r) {
+  double values[kColumns];
+  column_values(r, values);
   if (formatting_ == CsvFormatting::fmt_per_row) {
-    double values[kColumns];
-    column_values(r, values);
     fmt::memory_buffer line;
     for (const double value : values) fmt::format_to(std::back_inserter(line), "{:.10g},", value);
     line[line.size() - 1] = '\n';
     if (std::fwrite(line.data(), 1, line.size(), file_) != line.size()) failed_ = true;
     return;
   }
-  double values[kColumns];
-  column_values(r, values);
   // A row is at most 44 x 24 characters: room for it, then format in place.
   const std::size_t start = buffer_.size();
   buffer_.resize(start + kColumns * 32);
