@@ -10,3 +10,6 @@ option(IMD_BUILD_FUZZERS "Build the libFuzzer harnesses (clang: the fuzz preset)
 # Off by default, so that a user's newer compiler with new warnings still builds; the presets
 # CI builds turn it on.
 option(IMD_WARNINGS_AS_ERRORS "Compile with -Werror (every preset CI or the qemu tier builds)" OFF)
+# The design arithmetic (control/real.hpp): float on the MCU, whose FPU has no double; a host
+# build with it on runs the tests on the designs the MCU computes (the float-design preset).
+option(IMD_DESIGN_IN_FLOAT "Compute the designs in float, as the MCU does (always on there)" OFF)

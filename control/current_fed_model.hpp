@@ -12,26 +12,27 @@
 /// k_T = 3/2 carries the project's amplitude-invariant Clarke convention (the paper has 1).
 #include "control/frames.hpp"
 #include "control/motor_parameters.hpp"
+#include "control/real.hpp"
 
 namespace imd::control {
 
 /// Constant coefficients of the exact discrete model for one motor and period T0.
 struct CurrentFedCoefficients {
-  double T0_s = 0.0;                   ///< control period
-  double flux_decay = 0.0;             ///< e^{-eta T0}
-  double flux_from_i_now_H = 0.0;      ///< ls (1 - sigma - e^{-eta T0}), multiplies i_k
-  double flux_from_i_next_H = 0.0;     ///< ls sigma, multiplies i_{k+1}
-  double torque_per_flux_A = 0.0;      ///< k_T n_p: tau = k_T n_p i^T J phi, N m per Wb A
-  double eta_per_s = 0.0;              ///< decay rate of the torque inside a period
-  double speed_decay = 1.0;            ///< e^{-c T0 / J}
-  double speed_decay_minus_one = 0.0;  ///< e^{-c T0 / J} - 1 without cancellation (expm1)
-  double torque_to_speed = 0.0;        ///< (e^{-c T0/J} - e^{-eta T0}) / (J eta - c), rad/s per N m
-  double load_to_speed = 0.0;          ///< -(1 - e^{-c T0/J}) / c (-T0/J at c = 0), rad/s per N m
+  Real T0_s = 0.0;                   ///< control period
+  Real flux_decay = 0.0;             ///< e^{-eta T0}
+  Real flux_from_i_now_H = 0.0;      ///< ls (1 - sigma - e^{-eta T0}), multiplies i_k
+  Real flux_from_i_next_H = 0.0;     ///< ls sigma, multiplies i_{k+1}
+  Real torque_per_flux_A = 0.0;      ///< k_T n_p: tau = k_T n_p i^T J phi, N m per Wb A
+  Real eta_per_s = 0.0;              ///< decay rate of the torque inside a period
+  Real speed_decay = 1.0;            ///< e^{-c T0 / J}
+  Real speed_decay_minus_one = 0.0;  ///< e^{-c T0 / J} - 1 without cancellation (expm1)
+  Real torque_to_speed = 0.0;        ///< (e^{-c T0/J} - e^{-eta T0}) / (J eta - c), rad/s per N m
+  Real load_to_speed = 0.0;          ///< -(1 - e^{-c T0/J}) / c (-T0/J at c = 0), rad/s per N m
 };
 
 /// Computes the coefficients in closed form, stable for c -> 0 and for J eta -> c. Requires
 /// valid parameters and T0_s > 0. Not for tick context.
-CurrentFedCoefficients discretize_current_fed(const MotorParameters& motor, double T0_s);
+CurrentFedCoefficients discretize_current_fed(const MotorParameters& motor, Real T0_s);
 
 /// The same in the control arithmetic T: double is the reference above, float the MCU's
 /// (control/float_discretization.cpp). In float each coefficient is within 12 u (u = 2^-24)
@@ -40,14 +41,14 @@ CurrentFedCoefficients discretize_current_fed(const MotorParameters& motor, doub
 /// (near 1 at the drive's periods), (eta + c/J) / (eta - c/J) for torque_to_speed; expf and
 /// expm1f are taken within 1 ulp. Not for tick context.
 template <typename T>
-CurrentFedCoefficients discretize_current_fed(const MotorParameters& motor, double T0_s);
+CurrentFedCoefficients discretize_current_fed(const MotorParameters& motor, Real T0_s);
 template <>
 inline CurrentFedCoefficients discretize_current_fed<double>(const MotorParameters& motor,
-                                                             double T0_s) {
+                                                             Real T0_s) {
   return discretize_current_fed(motor, T0_s);
 }
 template <>
-CurrentFedCoefficients discretize_current_fed<float>(const MotorParameters& motor, double T0_s);
+CurrentFedCoefficients discretize_current_fed<float>(const MotorParameters& motor, Real T0_s);
 
 /// (exp(x) - 1) / x, equal to 1 at x = 0, without cancellation for small |x|.
 double phi1(double x) noexcept;

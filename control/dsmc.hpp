@@ -27,6 +27,7 @@
 #include <cstdint>
 #include <limits>
 
+#include "control/real.hpp"
 #include "control/voltage_fed_model.hpp"
 #include "control/frames.hpp"
 #include "control/input_disk.hpp"
@@ -41,17 +42,17 @@ enum class DsmcSpeedChannel : uint8_t {
 struct DsmcConfig {
   /// B_k is refused (singular) when |det B_k| is below its value for a pure magnetizing state
   /// at this squared flux: det B_k ~ 2 b1 eta2 a11 |Phi~|^2.
-  double min_flux2_Wb2 = 1e-3;
+  Real min_flux2_Wb2 = Real(1e-3);
   /// Reaching laws e_{k+1} = pole e_k of the speed and squared-flux errors, in [0, 1).
-  double speed_reaching_pole = 0.0;
-  double flux_reaching_pole = 0.0;
+  Real speed_reaching_pole = 0.0;
+  Real flux_reaching_pole = 0.0;
   DsmcSpeedChannel speed_channel = DsmcSpeedChannel::paper;
   /// The torque channel's current pole: the torque and the flux's current approach their
   /// targets as e_{k+1} = pole e_k (0: deadbeat, which passes the current's noise at
   /// sigma Ls / delta volts per ampere).
-  double current_pole = 0.0;
+  Real current_pole = 0.0;
   /// The torque channel's largest |I^T J Phi| (the torque limit over 3/2 p Lm/Lr), A Wb.
-  double torque_product_limit_AWb = 1e300;
+  Real torque_product_limit_AWb = std::numeric_limits<Real>::max();
 };
 
 template <typename T>
@@ -99,16 +100,16 @@ class Dsmc {
         eta3_(T(c.eta3)),
         omega_decay_(T(c.omega_decay)),
         load_to_omega_(T(c.load_to_omega)),
-        min_det_(T(std::abs(2.0 * c.b1 * c.eta2 * c.a11) * config.min_flux2_Wb2)),
+        min_det_(T(std::abs(2 * c.b1 * c.eta2 * c.a11) * config.min_flux2_Wb2)),
         speed_pole_(T(config.speed_reaching_pole)),
         flux_pole_(T(config.flux_reaching_pole)),
         torque_channel_(config.speed_channel == DsmcSpeedChannel::torque),
         current_pole_(T(config.current_pole)),
-        y_limit_(T(std::min(config.torque_product_limit_AWb, 1e30))) {
+        y_limit_(T(std::min(config.torque_product_limit_AWb, Real(1e30)))) {
     // Through the current, det B_k ~ 2 q b2 a11^3 |Phi~|^2: its floor scales alike.
     if (torque_channel_) {
-      const double q = c.a12 * c.b2 + c.a11 * c.b1;
-      min_det_ = T(std::abs(2.0 * q * c.b2 * c.a11 * c.a11 * c.a11) * config.min_flux2_Wb2);
+      const Real q = c.a12 * c.b2 + c.a11 * c.b1;
+      min_det_ = T(std::abs(2 * q * c.b2 * c.a11 * c.a11 * c.a11) * config.min_flux2_Wb2);
     }
   }
 

@@ -17,12 +17,13 @@
 #include <type_traits>
 
 #include "control/frames.hpp"
+#include "control/real.hpp"
 #include "control/voltage_fed_model.hpp"
 
 namespace imd::control {
 
 struct EncoderObserverConfig {
-  double bandwidth_rad_s = 400.0;  ///< the three error poles sit at exp(-bandwidth delta)
+  Real bandwidth_rad_s = 400.0;  ///< the three error poles sit at exp(-bandwidth delta)
 };
 
 /// Observer gain L for the mechanical model of `c`: the three poles of A - L C A at
@@ -97,8 +98,8 @@ template <typename T>
 /// measured angle is off by at most one step q, and the errors answer it through the impulse
 /// response (A - L C A)^j L, so they are bounded by q times its l1 norm. Construction only.
 struct QuantizationErrorBounds {
-  double omega_rad_s = 0.0;
-  double load_Nm = 0.0;
+  Real omega_rad_s = 0.0;
+  Real load_Nm = 0.0;
 };
 /// Computed in T: on the MCU in float, where a few thousand 3x3 steps cost tens of thousands of
 /// instructions rather than millions in soft double. The results are raised by 3 n epsilon for
@@ -121,7 +122,7 @@ QuantizationErrorBounds encoder_quantization_bounds(const VoltageFedCoefficients
     response = error * response;
   }
   const T rounding = T(1) + T(3 * terms) * std::numeric_limits<T>::epsilon();
-  return {double(omega * q_rad * rounding), double(load * q_rad * rounding)};
+  return {Real(omega * q_rad * rounding), Real(load * q_rad * rounding)};
 }
 
 template <typename T>

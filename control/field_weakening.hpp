@@ -16,11 +16,13 @@
 #include <cmath>
 #include <limits>
 
+#include "control/real.hpp"
+
 namespace imd::control {
 
 /// Share of the voltage disk the steady state may use above base speed, the same for every
 /// law; the rest is left to the transients of the current (or flux) control.
-inline constexpr double kFieldWeakeningVoltageShare = 0.9;
+inline constexpr Real kFieldWeakeningVoltageShare = Real(0.9);
 
 template <typename T>
 struct FieldWeakeningMotor {

@@ -24,7 +24,7 @@ float leakage_product_H2(float ls_H, float lr_H, float lm_H) noexcept {
 }  // namespace
 
 VoltageFedFloatGenerators voltage_fed_float_generators(const MotorParameters& motor,
-                                                       double delta_s) noexcept {
+                                                       Real delta_s) noexcept {
   const float rs = float(motor.Rs_Ohm), ls = float(motor.Ls_H), lm = float(motor.Lm_H);
   const float rr = float(motor.Rr_Ohm), lr = float(motor.Lr_H), j = float(motor.J_kgm2);
   const float delta = float(delta_s);
@@ -49,7 +49,7 @@ VoltageFedFloatGenerators voltage_fed_float_generators(const MotorParameters& mo
 }
 
 template <>
-VoltageFedCoefficients discretize_voltage_fed<float>(const MotorParameters& motor, double delta_s) {
+VoltageFedCoefficients discretize_voltage_fed<float>(const MotorParameters& motor, Real delta_s) {
   const VoltageFedFloatGenerators g = voltage_fed_float_generators(motor, delta_s);
   const float delta = g.delta_s;
   VoltageFedCoefficients c;
@@ -91,7 +91,7 @@ float phi1(float x) noexcept {
 }
 
 template <>
-CurrentFedCoefficients discretize_current_fed<float>(const MotorParameters& motor, double T0_s) {
+CurrentFedCoefficients discretize_current_fed<float>(const MotorParameters& motor, Real T0_s) {
   const float ls = float(motor.Ls_H), lm = float(motor.Lm_H), lr = float(motor.Lr_H);
   const float j = float(motor.J_kgm2), t0 = float(T0_s);
   const float eta = float(motor.Rr_Ohm) / lr;

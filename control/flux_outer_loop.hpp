@@ -19,24 +19,26 @@
 /// Tick context except the constructor.
 #include <cmath>
 
+#include "control/real.hpp"
+
 namespace imd::control {
 
 struct FluxOuterLoopGains {
-  double kp = 0.0;
-  double ki = 0.0;
+  Real kp = 0.0;
+  Real ki = 0.0;
 };
 
 /// Gains for a double closed-loop pole at exp(-T0 / time_constant_s).
-inline FluxOuterLoopGains place_flux_outer_loop(double flux_decay, double T0_s,
-                                                double time_constant_s) {
-  const double z = std::exp(-T0_s / time_constant_s);
-  return {1.0 + flux_decay - 2.0 * z, (1.0 - z) * (1.0 - z)};
+inline FluxOuterLoopGains place_flux_outer_loop(Real flux_decay, Real T0_s,
+                                                Real time_constant_s) {
+  const Real z = std::exp(-T0_s / time_constant_s);
+  return {1 + flux_decay - 2 * z, (1 - z) * (1 - z)};
 }
 
 template <typename T>
 class FluxOuterLoop {
  public:
-  FluxOuterLoop(double flux_decay, const FluxOuterLoopGains& gains) noexcept
+  FluxOuterLoop(Real flux_decay, const FluxOuterLoopGains& gains) noexcept
       : e_(T(flux_decay)), kp_(T(gains.kp)), ki_(T(gains.ki)) {}
 
   /// v2 for the next step from the squared stator-flux reference and measurement (Wb^2).

@@ -8,23 +8,23 @@ namespace imd::control {
 
 IfocGains design_ifoc(const MotorParameters& motor, const IfocSpec& spec) {
   const VoltageFedConstants k = derive_voltage_fed(motor);
-  const double T = spec.sample_period_s;
+  const Real T = spec.sample_period_s;
   IfocGains g;
   g.sample_period_s = T;
-  g.current_bandwidth_rad_s = spec.current_bandwidth_rad_s > 0.0
+  g.current_bandwidth_rad_s = spec.current_bandwidth_rad_s > 0
                                   ? spec.current_bandwidth_rad_s
                                   : default_current_bandwidth_rad_s(T);
-  g.speed_bandwidth_rad_s = spec.speed_bandwidth_rad_s > 0.0
+  g.speed_bandwidth_rad_s = spec.speed_bandwidth_rad_s > 0
                                 ? spec.speed_bandwidth_rad_s
                                 : default_speed_bandwidth_rad_s(
                                       g.current_bandwidth_rad_s, spec.speed_feedback_bandwidth_rad_s);
 
   // One axis after the feed-forward: i(k+1) = a i(k) + b u(k).
-  const double a = std::exp(-k.gamma_per_s * T);
-  const double b = -std::expm1(-k.gamma_per_s * T) / (k.sigma_H * k.gamma_per_s);
+  const Real a = std::exp(-k.gamma_per_s * T);
+  const Real b = -std::expm1(-k.gamma_per_s * T) / (k.sigma_H * k.gamma_per_s);
   g.current_pole = std::exp(-g.current_bandwidth_rad_s * T);
-  g.current_kp_V_per_A = (1.0 - g.current_pole) / b;
-  g.current_ki_V_per_A = g.current_kp_V_per_A * (1.0 - a);
+  g.current_kp_V_per_A = (1 - g.current_pole) / b;
+  g.current_ki_V_per_A = g.current_kp_V_per_A * (1 - a);
   g.speed = design_speed_pi(motor.J_kgm2, g.speed_bandwidth_rad_s, spec.torque_limit_Nm, T);
 
   g.sigma_H = k.sigma_H;
@@ -35,7 +35,7 @@ IfocGains design_ifoc(const MotorParameters& motor, const IfocSpec& spec) {
   g.Ls_H = motor.Ls_H;
   g.Rs_Ohm = motor.Rs_Ohm;
   g.Lm_over_Lr = motor.Lm_H / motor.Lr_H;
-  g.torque_constant_Nm_per_Wb_A = kClarkeTorqueFactor * motor.pole_pairs * g.Lm_over_Lr;
+  g.torque_constant_Nm_per_Wb_A = kClarkeTorqueFactor * Real(motor.pole_pairs) * g.Lm_over_Lr;
   g.pole_pairs = motor.pole_pairs;
   g.J_kgm2 = motor.J_kgm2;
   g.friction_Nms = motor.friction_Nms;

@@ -19,17 +19,18 @@
 
 #include "control/current_fed_model.hpp"
 #include "control/frames.hpp"
+#include "control/real.hpp"
 
 namespace imd::control {
 
 struct IolConfig {
   /// Largest angle between the stator flux and phi_r at step k+1: det B(k+1) stays below
   /// -cos(max_angle) of its value for aligned vectors (cos 60 deg = 0.5).
-  double max_angle_rad = 1.0471975511965976;
+  Real max_angle_rad = Real(1.0471975511965976);
   /// B_k is refused when the angle at step k exceeds this (det within cos of zero) or the
   /// stator flux is below min_flux_Wb.
-  double refuse_angle_rad = 1.5184364492350666;  // 87 degrees
-  double min_flux_Wb = 1e-3;
+  Real refuse_angle_rad = Real(1.5184364492350666);  // 87 degrees
+  Real min_flux_Wb = Real(1e-3);
 };
 
 enum class IolStatus { ok, singular };

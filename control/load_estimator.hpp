@@ -9,22 +9,23 @@
 #include <Eigen/Core>
 #include <complex>
 
+#include "control/real.hpp"
 #include "control/voltage_fed_model.hpp"
 #include "control/frames.hpp"
 
 namespace imd::control {
 
 struct LoadEstimatorGains {
-  double l1 = 0.0;
-  double l2 = 0.0;
+  Real l1 = 0.0;
+  Real l2 = 0.0;
 };
 
 /// Gains that give the error matrix of (13) the poles z1, z2 (real, |z| < 1):
 /// trace 1 - l1 = z1 + z2 and determinant -l1 + g l2 = z1 z2.
-inline LoadEstimatorGains place_load_estimator(const VoltageFedCoefficients& c, double z1,
-                                               double z2) {
+inline LoadEstimatorGains place_load_estimator(const VoltageFedCoefficients& c, Real z1,
+                                               Real z2) {
   LoadEstimatorGains gains;
-  gains.l1 = 1.0 - (z1 + z2);
+  gains.l1 = 1 - (z1 + z2);
   gains.l2 = (z1 * z2 + gains.l1) / c.load_to_omega;
   return gains;
 }

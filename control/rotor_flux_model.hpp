@@ -11,6 +11,7 @@
 
 #include "control/encoder_observer.hpp"
 #include "control/frames.hpp"
+#include "control/real.hpp"
 
 namespace imd::control {
 
@@ -19,8 +20,8 @@ class RotorFluxModel {
  public:
   /// `flux_decay` = e^{-T / tau_r}, `alpha_per_s` = 1 / tau_r; the slip divides by at least
   /// `min_flux_Wb`.
-  RotorFluxModel(double flux_decay, double alpha_per_s, double Lm_H, double period_s,
-                 double min_flux_Wb) noexcept
+  RotorFluxModel(Real flux_decay, Real alpha_per_s, Real Lm_H, Real period_s,
+                 Real min_flux_Wb) noexcept
       : decay_(T(flux_decay)),
         alpha_Lm_(T(alpha_per_s * Lm_H)),
         Lm_(T(Lm_H)),

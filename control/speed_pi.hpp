@@ -5,21 +5,23 @@
 /// was trimmed (undo_last_integration). Tick context except the constructor.
 #include <algorithm>
 
+#include "control/real.hpp"
+
 namespace imd::control {
 
 struct SpeedPiConfig {
-  double kp_Nm_per_rad_s = 0.0;  ///< proportional gain
-  double ki_Nm_per_rad = 0.0;    ///< integral gain (per second of integrated error)
-  double torque_limit_Nm = 0.0;  ///< |output| <= this
-  double period_s = 1e-3;
+  Real kp_Nm_per_rad_s = 0.0;  ///< proportional gain
+  Real ki_Nm_per_rad = 0.0;    ///< integral gain (per second of integrated error)
+  Real torque_limit_Nm = 0.0;  ///< |output| <= this
+  Real period_s = Real(1e-3);
 };
 
 /// Gains for a speed loop of bandwidth w_c on inertia J (Kp = J w_c, integral time 4 / w_c,
 /// which keeps the integral zero a decade-ish below the crossover).
-inline SpeedPiConfig design_speed_pi(double J_kgm2, double bandwidth_rad_s, double torque_limit_Nm,
-                                     double period_s) {
-  const double kp = J_kgm2 * bandwidth_rad_s;
-  return {kp, kp * bandwidth_rad_s / 4.0, torque_limit_Nm, period_s};
+inline SpeedPiConfig design_speed_pi(Real J_kgm2, Real bandwidth_rad_s, Real torque_limit_Nm,
+                                     Real period_s) {
+  const Real kp = J_kgm2 * bandwidth_rad_s;
+  return {kp, kp * bandwidth_rad_s / Real(4.0), torque_limit_Nm, period_s};
 }
 
 template <typename T>

@@ -12,32 +12,33 @@
 /// c = 0 the paper's equations result). The derivation is in docs/derivations.md.
 #include "control/frames.hpp"
 #include "control/motor_parameters.hpp"
+#include "control/real.hpp"
 
 namespace imd::control {
 
 /// The constant coefficients of the exact sampled model for one motor and sample period.
 struct VoltageFedCoefficients {
-  double delta_s = 0.0;  ///< sample period
+  Real delta_s = 0.0;  ///< sample period
   // A_d = [a11 I, a12 I; a21 I, a22 I] and B_d = [b1 I; b2 I].
-  double a11 = 0.0, a12 = 0.0, a21 = 0.0, a22 = 0.0;
-  double b1 = 0.0, b2 = 0.0;
+  Real a11 = 0.0, a12 = 0.0, a21 = 0.0, a22 = 0.0;
+  Real b1 = 0.0, b2 = 0.0;
   // Speed and position increments per unit of the skew products (units rad/s or rad per A Wb,
   // per Wb V and per A V).
-  double eta1 = 0.0, eta2 = 0.0, eta3 = 0.0;
-  double kappa1 = 0.0, kappa2 = 0.0, kappa3 = 0.0;
+  Real eta1 = 0.0, eta2 = 0.0, eta3 = 0.0;
+  Real kappa1 = 0.0, kappa2 = 0.0, kappa3 = 0.0;
   // Mechanical coefficients: exp(-c delta/J) and its integrals; 1, delta, -delta/J and
   // -delta^2/(2J) without friction.
-  double omega_decay = 1.0;            ///< coefficient of w_k in w_{k+1}
-  double omega_decay_minus_one = 0.0;  ///< omega_decay - 1 without cancellation (expm1)
-  double omega_to_theta_s = 0.0;       ///< coefficient of w_k in th_{k+1}
-  double load_to_omega = 0.0;          ///< coefficient of C_L in w_{k+1}, rad/s per N m
-  double load_to_theta = 0.0;          ///< coefficient of C_L in th_{k+1}, rad per N m
+  Real omega_decay = 1.0;            ///< coefficient of w_k in w_{k+1}
+  Real omega_decay_minus_one = 0.0;  ///< omega_decay - 1 without cancellation (expm1)
+  Real omega_to_theta_s = 0.0;       ///< coefficient of w_k in th_{k+1}
+  Real load_to_omega = 0.0;          ///< coefficient of C_L in w_{k+1}, rad/s per N m
+  Real load_to_theta = 0.0;          ///< coefficient of C_L in th_{k+1}, rad per N m
 };
 
 /// Computes the coefficients numerically exactly from structured matrix exponentials
 /// (control/block_exponential.hpp: a few hundred multiply-adds, no allocation). Not for tick
 /// context: start-up and the service loop. Requires valid parameters and delta_s > 0.
-VoltageFedCoefficients discretize_voltage_fed(const MotorParameters& motor, double delta_s);
+VoltageFedCoefficients discretize_voltage_fed(const MotorParameters& motor, Real delta_s);
 
 /// The same coefficients computed in the control arithmetic T: T = double is the reference
 /// above; T = float is the MCU's, cheap enough to recompute outside the tick for a new rotor
@@ -54,14 +55,14 @@ VoltageFedCoefficients discretize_voltage_fed(const MotorParameters& motor, doub
 /// 3 u and twice sigma's conditioning Ls Lr / (Ls Lr - Lm^2) (tens for real motors) in u.
 /// docs/derivations.md derives it. Not for tick context.
 template <typename T>
-VoltageFedCoefficients discretize_voltage_fed(const MotorParameters& motor, double delta_s);
+VoltageFedCoefficients discretize_voltage_fed(const MotorParameters& motor, Real delta_s);
 template <>
 inline VoltageFedCoefficients discretize_voltage_fed<double>(const MotorParameters& motor,
-                                                             double delta_s) {
+                                                             Real delta_s) {
   return discretize_voltage_fed(motor, delta_s);
 }
 template <>
-VoltageFedCoefficients discretize_voltage_fed<float>(const MotorParameters& motor, double delta_s);
+VoltageFedCoefficients discretize_voltage_fed<float>(const MotorParameters& motor, Real delta_s);
 
 /// The generators the float discretization exponentiates, already times delta: the axis
 /// generator A3 delta, its additive compound times delta and the friction g = -f delta / J.
@@ -74,7 +75,7 @@ struct VoltageFedFloatGenerators {
   float delta_s = 0.0f;         ///< sample period
 };
 VoltageFedFloatGenerators voltage_fed_float_generators(const MotorParameters& motor,
-                                                       double delta_s) noexcept;
+                                                       Real delta_s) noexcept;
 
 /// Generator of one axis of the rotor-frame dynamics (5) with the held input as a third state:
 /// d/dt (phi, i, v) = A3 (phi, i, v); A = A3 (x) I2 acts on both axes alike.

@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <limits>
 
+#include "control/real.hpp"
 #include "firmware/protection/protection_config.hpp"
 
 namespace imd::firmware {
@@ -17,7 +18,7 @@ enum class ControllerKind : uint8_t {
 inline constexpr int kControllerCount = 3;
 
 struct DriveConfig {
-  double sample_period_s = 1e-4;  ///< control period delta
+  Real sample_period_s = Real(1e-4);  ///< control period delta
   ControllerKind controller = ControllerKind::dsmc;
   /// Ticks between a duty write and its effect; the tick predicts that far with the exact
   /// model (0 or 1).
@@ -27,64 +28,64 @@ struct DriveConfig {
   bool compensate_latency = true;
 
   // The current-fed controller (iol).
-  double iol_period_s = 1e-3;  ///< T0, a whole number of sample periods
+  Real iol_period_s = Real(1e-3);  ///< T0, a whole number of sample periods
   /// Ticks from a current command to the current: 1 for the deadbeat current loop on the PWM
   /// (it reaches its target one tick after it acts); 0 for a power stage that imposes the
   /// current at once (the simulation's ideal current source).
   int current_response_ticks = 1;
   bool outer_speed_loop = false;  ///< v1 from a speed PI (else the torque reference)
   bool outer_flux_loop = false;   ///< v2 from the Fig. 5 loop (else from (21))
-  double speed_loop_bandwidth_rad_s = 30.0;
-  double torque_limit_Nm = 240.0;
-  double flux_loop_time_constant_s = 0.01;
+  Real speed_loop_bandwidth_rad_s = 30.0;
+  Real torque_limit_Nm = 240.0;
+  Real flux_loop_time_constant_s = Real(0.01);
 
   // The field-oriented controller (ifoc); 0: the rules of docs/ifoc.md.
-  double ifoc_current_bandwidth_rad_s = 0.0;
-  double ifoc_speed_bandwidth_rad_s = 0.0;
+  Real ifoc_current_bandwidth_rad_s = 0.0;
+  Real ifoc_speed_bandwidth_rad_s = 0.0;
 
   // Control law.
-  double max_accel_rad_s2 = std::numeric_limits<double>::infinity();  ///< speed reference ramp
-  double speed_reaching_pole = 0.0;  ///< e_{k+1} = pole e_k; 0 is the paper's deadbeat law
-  double flux_reaching_pole = 0.0;
+  Real max_accel_rad_s2 = std::numeric_limits<double>::infinity();  ///< speed reference ramp
+  Real speed_reaching_pole = 0.0;  ///< e_{k+1} = pole e_k; 0 is the paper's deadbeat law
+  Real flux_reaching_pole = 0.0;
   /// The DSMC's speed channel: through the torque of the next step (false, the default; its
   /// speed error decays at dsmc_speed_bandwidth_rad_s), or the paper's, which sets the next
   /// step's speed directly with speed_reaching_pole (true: to reproduce paper 000).
   bool dsmc_paper_speed_channel = false;
-  double dsmc_speed_bandwidth_rad_s = 0.0;  ///< 0: the IFOC's rule (docs/control.md)
+  Real dsmc_speed_bandwidth_rad_s = 0.0;  ///< 0: the IFOC's rule (docs/control.md)
 
   // Limits.
   bool voltage_limited = true;      ///< false only to reproduce the paper (no limit)
-  double modulation_margin = 0.95;  ///< share of the SVPWM linear range the law may use
-  double i_max_A = std::numeric_limits<double>::infinity();  ///< motor and inverter current limit
-  double current_margin = 0.95;  ///< share of i_max the law may plan for
+  Real modulation_margin = Real(0.95);  ///< share of the SVPWM linear range the law may use
+  Real i_max_A = std::numeric_limits<double>::infinity();  ///< motor and inverter current limit
+  Real current_margin = Real(0.95);  ///< share of i_max the law may plan for
 
   // The inverter.
-  double dead_time_s = 0.0;  ///< the PWM dead time per switching edge the board programs
+  Real dead_time_s = 0.0;  ///< the PWM dead time per switching edge the board programs
   bool compensate_dead_time = true;  ///< add the dead time's voltage loss back to the duties
 
   // Start-up.
   int adc_calibration_ticks = 256;     ///< offset measurement with the PWM off; 0 skips it
-  double adc_offset_limit_A = 0.5;     ///< a larger measured offset is a fault
-  double magnetizing_current_A = 0.0;  ///< 0: sqrt(flux2_ref)/Lm, capped at 0.9 i_max
-  double magnetized_fraction = 0.95;   ///< running once |Phi^|^2 >= this * reference
-  double magnetizing_timeout_s = 2.0;
+  Real adc_offset_limit_A = 0.5;     ///< a larger measured offset is a fault
+  Real magnetizing_current_A = 0.0;  ///< 0: sqrt(flux2_ref)/Lm, capped at 0.9 i_max
+  Real magnetized_fraction = Real(0.95);   ///< running once |Phi^|^2 >= this * reference
+  Real magnetizing_timeout_s = 2.0;
 
   // Estimation.
-  double encoder_observer_bandwidth_rad_s = 400.0;
+  Real encoder_observer_bandwidth_rad_s = 400.0;
   /// Use the paper's Section IV estimators (flux observer and load estimator on a measured
   /// speed) instead of the encoder observer's speed and load.
   bool section_iv_load_estimator = false;
-  double load_estimator_pole = 0.99;  ///< double pole of the error matrix (13)
-  double min_flux2_Wb2 = 1e-3;        ///< below it B_k counts as singular
+  Real load_estimator_pole = Real(0.99);  ///< double pole of the error matrix (13)
+  Real min_flux2_Wb2 = Real(1e-3);        ///< below it B_k counts as singular
 
   // Rotor-resistance tracking (docs/robustness.md): a reactive-power MRAS estimates Rr while
   // a law runs, and the model is rebuilt on the estimate outside the tick.
   bool rotor_resistance_tracking = true;
-  double rr_convergence_time_constant_s = 0.0;  ///< at slip tangent 1; 0: 4 tau_r
+  Real rr_convergence_time_constant_s = 0.0;  ///< at slip tangent 1; 0: 4 tau_r
   /// Rebuild once the estimate is this far from the model (0: at every interval, even on the
   /// same value: what the tests use to exercise the swap).
-  double rr_retune_share = 0.005;
-  double rr_retune_interval_s = 0.05;  ///< and no more often than this
+  Real rr_retune_share = Real(0.005);
+  Real rr_retune_interval_s = Real(0.05);  ///< and no more often than this
 
   ProtectionConfig protection;
   /// The tick's stages are timed on one tick in this many (1: every tick); the whole tick is
@@ -99,10 +100,10 @@ struct DriveConfig {
   /// Enable once calibrated, without a command (scenario profiles).
   bool auto_enable = false;
   int telemetry_rate_Hz = 100;  ///< fast telemetry, 10..1000
-  double min_flux2_command_Wb2 = 0.01;  ///< smallest set_flux accepted (10 x min_flux2_Wb2)
-  double max_flux2_Wb2 = 4.0;           ///< largest set_flux accepted
+  Real min_flux2_command_Wb2 = Real(0.01);  ///< smallest set_flux accepted (10 x min_flux2_Wb2)
+  Real max_flux2_Wb2 = 4.0;           ///< largest set_flux accepted
   /// Initial references over CAN, before any set_speed or set_flux.
-  double flux2_ref_Wb2 = 0.2, stator_flux2_ref_Wb2 = 1.0;
+  Real flux2_ref_Wb2 = Real(0.2), stator_flux2_ref_Wb2 = 1.0;
 
   // Board lines: indices into DrivePeripherals::gpio, -1 where the board has none.
   /// Hardware enable input (safe-torque-off style interlock): while it is inactive the drive
@@ -114,13 +115,13 @@ struct DriveConfig {
   int brake_output_line = -1;
   /// The brake's release time (its datasheet's): after the line releases it, the brake may
   /// still hold the rotor this long.
-  double brake_release_time_s = 0.1;
+  Real brake_release_time_s = Real(0.1);
   int timing_output_line = -1;  ///< active while the tick computes (to watch on a scope)
 
   // Disable: ramp to a stop, then PWM off.
-  double stop_decel_rad_s2 = 200.0;
-  double stop_speed_rad_s = 1.0;  ///< PWM off once the ramp is at 0 and |speed| below this
-  double stop_timeout_s = 10.0;   ///< PWM off after this even if the motor still turns
+  Real stop_decel_rad_s2 = 200.0;
+  Real stop_speed_rad_s = 1.0;  ///< PWM off once the ramp is at 0 and |speed| below this
+  Real stop_timeout_s = 10.0;   ///< PWM off after this even if the motor still turns
 };
 
 }  // namespace imd::firmware

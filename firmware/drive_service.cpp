@@ -52,15 +52,15 @@ void Drive<T>::retune() noexcept {
     return;  // not tracking, no model, or the last retune not yet taken
   }
   const uint32_t k = tick_published_.load(std::memory_order_relaxed);
-  if (double(uint32_t(k - last_retune_tick_)) * config_.sample_period_s <
+  if (Real(uint32_t(k - last_retune_tick_)) * config_.sample_period_s <
       config_.rr_retune_interval_s) {
     return;
   }
   const MotorModel<T>& now = *models_[active_];
-  const double estimate_Ohm = double(rr_estimate_Ohm_.load(std::memory_order_relaxed));
-  if (!(estimate_Ohm > 0.0) ||
-      (config_.rr_retune_share > 0.0 &&
-       std::abs(estimate_Ohm / now.motor.Rr_Ohm - 1.0) < config_.rr_retune_share)) {
+  const Real estimate_Ohm = Real(rr_estimate_Ohm_.load(std::memory_order_relaxed));
+  if (!(estimate_Ohm > 0) ||
+      (config_.rr_retune_share > 0 &&
+       std::abs(estimate_Ohm / now.motor.Rr_Ohm - 1) < config_.rr_retune_share)) {
     return;
   }
   const std::optional<control::MotorParameters> record = bank_.record();
@@ -81,7 +81,7 @@ void Drive<T>::plan_commissioning() noexcept {
     bank_.answer(ParameterStatus::not_set);
     return;
   }
-  const double v_bus_V = double(bank_.access().value);
+  const Real v_bus_V = Real(bank_.access().value);
   const bool rotate = bank_.access().field == 1;
   std::optional<InertiaPlan> rotating;
   if (rotate) {

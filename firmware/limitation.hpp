@@ -16,6 +16,7 @@
 #include <cstdint>
 
 #include "control/ifoc_design.hpp"
+#include "control/real.hpp"
 #include "firmware/drive_config.hpp"
 
 namespace imd::firmware {
@@ -46,10 +47,10 @@ constexpr const char* limitation_name(Limitation l) noexcept {
 /// Ticks of a limit held that raise `limited`: four time constants of the default speed loop
 /// at this sample period and encoder observer (about 40 ms at 10 kHz).
 inline uint32_t limited_window_ticks(const DriveConfig& config) noexcept {
-  const double bandwidth_rad_s = control::default_speed_bandwidth_rad_s(
+  const Real bandwidth_rad_s = control::default_speed_bandwidth_rad_s(
       control::default_current_bandwidth_rad_s(config.sample_period_s),
       config.encoder_observer_bandwidth_rad_s);
-  return static_cast<uint32_t>(std::lround(4.0 / (bandwidth_rad_s * config.sample_period_s)));
+  return static_cast<uint32_t>(std::lround(Real(4.0) / (bandwidth_rad_s * config.sample_period_s)));
 }
 
 class LimitedMonitor {

@@ -10,6 +10,7 @@
 /// runs, a model on a new rotor resistance replaces it at a tick boundary and takes over its state
 /// (continue_from), so that the tracked Rr reaches every part (docs/robustness.md).
 #include "control/motor_parameters.hpp"
+#include "control/real.hpp"
 #include "control/rotor_resistance_mras.hpp"
 #include "control/voltage_fed_model.hpp"
 #include "firmware/drive_config.hpp"
@@ -28,8 +29,8 @@ namespace imd::firmware {
 /// The board quantities the model's parts need besides the motor.
 struct BoardScales {
   hal::Pwm& pwm;
-  double encoder_counts_per_rev;
-  double adc_A_per_code;
+  Real encoder_counts_per_rev;
+  Real adc_A_per_code;
 };
 
 /// The rotor-resistance tracker's settings from the drive's.
@@ -45,10 +46,10 @@ struct MotorModel {
   /// `nominal_Rr_Ohm`: the motor record's rotor resistance, which bounds the tracked one (0:
   /// m's own).
   MotorModel(const control::MotorParameters& m, const DriveConfig& config,
-             const BoardScales& board, double nominal_Rr_Ohm = 0.0)
+             const BoardScales& board, Real nominal_Rr_Ohm = 0.0)
       : motor(m),
         coefficients(control::discretize_voltage_fed<T>(m, config.sample_period_s)),
-        observers(coefficients, m.pole_pairs, config.encoder_observer_bandwidth_rad_s),
+        observers(coefficients, Real(m.pole_pairs), config.encoder_observer_bandwidth_rad_s),
         predictor(coefficients, config.pwm_latency_ticks, config.compensate_latency),
         laws(LawContext{m, config, coefficients}),
         magnetizer(m, coefficients, config),
@@ -60,7 +61,7 @@ struct MotorModel {
                control::derive_voltage_fed(m).sigma_H}),
         checks(m, coefficients, config, board.encoder_counts_per_rev, board.adc_A_per_code),
         dc_brake(m, config),
-        rotor_resistance(m, mras_config(config), nominal_Rr_Ohm > 0.0 ? nominal_Rr_Ohm : m.Rr_Ohm) {}
+        rotor_resistance(m, mras_config(config), nominal_Rr_Ohm > 0 ? nominal_Rr_Ohm : m.Rr_Ohm) {}
   MotorModel(const MotorModel&) = delete;
   MotorModel& operator=(const MotorModel&) = delete;
 

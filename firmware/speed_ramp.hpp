@@ -5,20 +5,22 @@
 #include <algorithm>
 #include <cmath>
 
+#include "control/real.hpp"
+
 namespace imd::firmware {
 
 template <typename T>
 class SpeedRamp {
  public:
   /// max_accel_rad_s2 may be infinite (no limit).
-  SpeedRamp(double max_accel_rad_s2, double period_s) noexcept
+  SpeedRamp(Real max_accel_rad_s2, Real period_s) noexcept
       : max_step_(step(max_accel_rad_s2, period_s)) {}
 
   /// Changes the limit, as the largest change per period (the stop ramp uses its own); an
   /// infinite step means no limit. Tick context: computed beforehand with step(), not here.
   void set_max_step(T max_step_rad_s) noexcept { max_step_ = max_step_rad_s; }
   /// The per-period step of an acceleration limit (construction only).
-  static T step(double max_accel_rad_s2, double period_s) noexcept {
+  static T step(Real max_accel_rad_s2, Real period_s) noexcept {
     return T(max_accel_rad_s2 * period_s);
   }
   T value() const noexcept { return value_; }

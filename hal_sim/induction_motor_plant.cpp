@@ -46,8 +46,8 @@ InductionMotorPlant::InductionMotorPlant(const control::MotorParameters& motor,
 
 void InductionMotorPlant::set_resistances(double Rs_Ohm, double Rr_Ohm) noexcept {
   assert(Rs_Ohm > 0.0 && Rr_Ohm > 0.0);
-  motor_.Rs_Ohm = Rs_Ohm;
-  motor_.Rr_Ohm = Rr_Ohm;
+  motor_.Rs_Ohm = Real(Rs_Ohm);
+  motor_.Rr_Ohm = Real(Rr_Ohm);
   k_ = control::derive_voltage_fed(motor_);
 }
 

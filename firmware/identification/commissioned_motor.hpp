@@ -10,6 +10,7 @@
 #include <optional>
 
 #include "control/motor_parameters.hpp"
+#include "control/real.hpp"
 #include "firmware/identification/inertia_identifier.hpp"
 #include "firmware/identification/inertia_plan.hpp"
 #include "firmware/identification/standstill_identifier.hpp"
@@ -21,18 +22,18 @@ control::MotorParameters commissioned_motor(const StandstillResult<T>& r, const 
                                             const std::optional<control::MotorParameters>& before,
                                             const std::optional<Mechanics<T>>& mechanics = {}) {
   control::MotorParameters m;
-  m.Rs_Ohm = double(r.Rs_Ohm);
-  m.Ls_H = double(r.Ls_H);
+  m.Rs_Ohm = Real(r.Rs_Ohm);
+  m.Ls_H = Real(r.Ls_H);
   m.Lr_H = m.Ls_H;
-  m.Lm_H = std::sqrt(m.Ls_H * double(r.Lm2_over_Lr_H));
-  m.Rr_Ohm = m.Lr_H / double(r.tau_r_s);
+  m.Lm_H = std::sqrt(m.Ls_H * Real(r.Lm2_over_Lr_H));
+  m.Rr_Ohm = m.Lr_H / Real(r.tau_r_s);
   m.pole_pairs = n.pole_pairs;
   if (mechanics) {
-    m.J_kgm2 = double(mechanics->J_kgm2);
-    m.friction_Nms = std::max(0.0, double(mechanics->friction_Nms));
+    m.J_kgm2 = Real(mechanics->J_kgm2);
+    m.friction_Nms = std::max(Real(0.0), Real(mechanics->friction_Nms));
   } else {
     m.J_kgm2 = before ? before->J_kgm2 : catalogue_inertia_kgm2(n);
-    m.friction_Nms = before ? before->friction_Nms : 0.0;
+    m.friction_Nms = before ? before->friction_Nms : 0;
   }
   return m;
 }

@@ -13,6 +13,7 @@
 #include <cstdint>
 
 #include "control/frames.hpp"
+#include "control/real.hpp"
 #include "firmware/identification/compensated_sum.hpp"
 #include "firmware/identification/standstill_identifier.hpp"
 
@@ -35,19 +36,19 @@ enum class InertiaOutcome : uint8_t {
 /// What the rotating step is planned from besides the standstill result (double, outside the
 /// tick; the rules are in plan_inertia_test()).
 struct InertiaPlan {
-  double period_s = 1e-4;
-  double rad_per_count = 0.0;      ///< the encoder's mechanical angle per count
-  double omega_rated_rad_s = 0.0;  ///< electrical, 2 pi f_rated
-  double v_phase_peak_V = 0.0;     ///< rated phase voltage, peak
-  double i_limit_A = 0.0;          ///< the test's current magnitude limit (peak)
-  double v_limit_V = 0.0;          ///< the loop's output limit (linear SVPWM range)
-  double J_guess_kgm2 = 0.0;       ///< the inertia the torque is sized on (catalogue)
+  Real period_s = Real(1e-4);
+  Real rad_per_count = 0.0;      ///< the encoder's mechanical angle per count
+  Real omega_rated_rad_s = 0.0;  ///< electrical, 2 pi f_rated
+  Real v_phase_peak_V = 0.0;     ///< rated phase voltage, peak
+  Real i_limit_A = 0.0;          ///< the test's current magnitude limit (peak)
+  Real v_limit_V = 0.0;          ///< the loop's output limit (linear SVPWM range)
+  Real J_guess_kgm2 = 0.0;       ///< the inertia the torque is sized on (catalogue)
   int pole_pairs = 1;
-  double accelerate_s = 1.0;       ///< planned acceleration time with J_guess
-  double max_accelerate_s = 30.0;  ///< beyond this with no motion: skipped
-  double max_coast_s = 10.0;
-  double max_brake_extra_s = 1.0;  ///< the brake may take the acceleration's time plus this
-  double crossover_rad_s = 2.0 * 3.14159265358979 * 200.0;  ///< current loop bandwidth
+  Real accelerate_s = 1.0;       ///< planned acceleration time with J_guess
+  Real max_accelerate_s = 30.0;  ///< beyond this with no motion: skipped
+  Real max_coast_s = 10.0;
+  Real max_brake_extra_s = 1.0;  ///< the brake may take the acceleration's time plus this
+  Real crossover_rad_s = Real(2.0 * 3.14159265358979 * 200.0);  ///< current loop bandwidth
 };
 
 /// The plan in the tick's arithmetic, converted outside the tick (the rotating step is built
@@ -66,10 +67,10 @@ struct InertiaSettings {
         accelerate_s(T(p.accelerate_s)),
         // At most a twentieth of the sample rate: the 1.5 periods of delay then cost 27 deg.
         crossover_rad_s(
-            T(std::min(p.crossover_rad_s, 2.0 * 3.14159265358979 / (20.0 * p.period_s)))),
+            T(std::min(p.crossover_rad_s, 2 * std::numbers::pi_v<Real> / (20 * p.period_s)))),
         max_accelerate_ticks(static_cast<uint32_t>(p.max_accelerate_s / p.period_s)),
         max_coast_ticks(static_cast<uint32_t>(p.max_coast_s / p.period_s)),
-        ramp_ticks(static_cast<uint32_t>(0.05 / p.period_s)),
+        ramp_ticks(static_cast<uint32_t>(Real(0.05) / p.period_s)),
         brake_extra_ticks(static_cast<uint32_t>(p.max_brake_extra_s / p.period_s)) {}
   T period_s, rad_per_count, omega_rated_rad_s, v_phase_peak_V, i_limit_A, v_limit_V;
   T J_guess_kgm2, pole_pairs, accelerate_s, crossover_rad_s;

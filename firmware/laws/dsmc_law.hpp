@@ -8,6 +8,7 @@
 #include "control/dsmc.hpp"
 #include "control/field_weakening.hpp"
 #include "control/ifoc_design.hpp"
+#include "control/real.hpp"
 #include "firmware/drive_config.hpp"
 #include "firmware/laws/control_law.hpp"
 #include "firmware/laws/law_context.hpp"
@@ -26,7 +27,7 @@ class DsmcLaw final : public ControlLaw<T> {
         p_(T(c.motor.pole_pairs)),
         slip_per_A_(T(c.motor.Rr_Ohm / c.motor.Lr_H * c.motor.Lm_H)),
         min_flux2_(T(c.config.min_flux2_Wb2)),
-        flux2_rise_per_tick_(T(2.0 * c.config.sample_period_s * c.motor.Rr_Ohm / c.motor.Lr_H)) {}
+        flux2_rise_per_tick_(T(2 * c.config.sample_period_s * c.motor.Rr_Ohm / c.motor.Lr_H)) {}
 
   /// The law's settings: the paper's speed channel with its reaching pole, or the torque
   /// channel with the pole of its speed bandwidth (docs/control.md). Construction only.
@@ -40,18 +41,18 @@ class DsmcLaw final : public ControlLaw<T> {
       return d;
     }
     d.speed_channel = control::DsmcSpeedChannel::torque;
-    const double speed_bandwidth_rad_s = dsmc_speed_bandwidth_rad_s(c.config);
+    const Real speed_bandwidth_rad_s = dsmc_speed_bandwidth_rad_s(c.config);
     d.speed_reaching_pole = std::exp(-speed_bandwidth_rad_s * c.config.sample_period_s);
     // The flux loop a decade below the current's, as the speed loop's first bound: the load
     // steps' cross-coupling is then corrected within a few milliseconds (the current disk
     // bounds what a flux step asks of the d current).
-    const double flux_bandwidth_rad_s = current_bandwidth_rad_s(c.config) / 10.0;
+    const Real flux_bandwidth_rad_s = current_bandwidth_rad_s(c.config) / Real(10.0);
     d.flux_reaching_pole = std::exp(-flux_bandwidth_rad_s * c.config.sample_period_s);
     // The current approaches its target at the IFOC's current bandwidth, f_s / 20 in rad/s
     // (control/ifoc_design.hpp): pole e^{-pi/10} = 0.73 at any sample rate.
     d.current_pole = std::exp(-current_bandwidth_rad_s(c.config) * c.config.sample_period_s);
-    const double torque_per_product =
-        control::kClarkeTorqueFactor * c.motor.pole_pairs * c.motor.Lm_H / c.motor.Lr_H;
+    const Real torque_per_product =
+        control::kClarkeTorqueFactor * Real(c.motor.pole_pairs) * c.motor.Lm_H / c.motor.Lr_H;
     d.torque_product_limit_AWb = c.config.torque_limit_Nm / torque_per_product;
     return d;
   }
@@ -59,12 +60,12 @@ class DsmcLaw final : public ControlLaw<T> {
   /// min(w_c / 10, w_obs / 4) with w_c = 2 pi f_s / 20 (control/ifoc_design.hpp): a decade below
   /// what a current loop at this sample rate reaches, and a factor 4 below the speed estimate's
   /// bandwidth.
-  static double dsmc_speed_bandwidth_rad_s(const DriveConfig& config) noexcept {
-    if (config.dsmc_speed_bandwidth_rad_s > 0.0) return config.dsmc_speed_bandwidth_rad_s;
+  static Real dsmc_speed_bandwidth_rad_s(const DriveConfig& config) noexcept {
+    if (config.dsmc_speed_bandwidth_rad_s > 0) return config.dsmc_speed_bandwidth_rad_s;
     return control::default_speed_bandwidth_rad_s(current_bandwidth_rad_s(config),
                                                   config.encoder_observer_bandwidth_rad_s);
   }
-  static double current_bandwidth_rad_s(const DriveConfig& config) noexcept {
+  static Real current_bandwidth_rad_s(const DriveConfig& config) noexcept {
     return control::default_current_bandwidth_rad_s(config.sample_period_s);
   }
 

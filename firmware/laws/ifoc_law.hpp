@@ -7,9 +7,11 @@
 /// term off again and the stator voltage acts as decided.
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "control/ifoc.hpp"
 #include "control/ifoc_design.hpp"
+#include "control/real.hpp"
 #include "firmware/drive_config.hpp"
 #include "firmware/laws/control_law.hpp"
 #include "firmware/laws/law_context.hpp"
@@ -26,7 +28,7 @@ inline control::IfocSpec ifoc_spec(const DriveConfig& config) noexcept {
   s.speed_feedback_bandwidth_rad_s = config.encoder_observer_bandwidth_rad_s;
   s.torque_limit_Nm = config.torque_limit_Nm;
   s.current_limit_A = std::isfinite(config.i_max_A) ? config.current_margin * config.i_max_A
-                                                     : 1e300;
+                                                     : std::numeric_limits<Real>::max();
   s.min_flux_Wb = std::sqrt(config.min_flux2_Wb2);
   s.latency_ticks = config.compensate_latency ? config.pwm_latency_ticks : 0;
   return s;

@@ -1,11 +1,12 @@
 #include "firmware/parameters/motor_record.hpp"
 
 #include <cmath>
-#include <cstring>
+
+#include "firmware/parameters/binary64.hpp"
 
 namespace imd::firmware {
 
-double field_value(const control::MotorParameters& m, MotorField field) noexcept {
+Real field_value(const control::MotorParameters& m, MotorField field) noexcept {
   switch (field) {
     case MotorField::Rs_Ohm: return m.Rs_Ohm;
     case MotorField::Ls_H: return m.Ls_H;
@@ -13,13 +14,13 @@ double field_value(const control::MotorParameters& m, MotorField field) noexcept
     case MotorField::Rr_Ohm: return m.Rr_Ohm;
     case MotorField::Lr_H: return m.Lr_H;
     case MotorField::J_kgm2: return m.J_kgm2;
-    case MotorField::pole_pairs: return double(m.pole_pairs);
+    case MotorField::pole_pairs: return Real(m.pole_pairs);
     case MotorField::friction_Nms: return m.friction_Nms;
     default: return 0.0;
   }
 }
 
-void set_field(control::MotorParameters& m, MotorField field, double value) noexcept {
+void set_field(control::MotorParameters& m, MotorField field, Real value) noexcept {
   switch (field) {
     case MotorField::Rs_Ohm: m.Rs_Ohm = value; break;
     case MotorField::Ls_H: m.Ls_H = value; break;
@@ -33,7 +34,7 @@ void set_field(control::MotorParameters& m, MotorField field, double value) noex
   }
 }
 
-double field_value(const MotorRecord& r, MotorField field) noexcept {
+Real field_value(const MotorRecord& r, MotorField field) noexcept {
   switch (field) {
     case MotorField::rated_voltage_V: return r.nameplate.rated_voltage_V;
     case MotorField::rated_current_A: return r.nameplate.rated_current_A;
@@ -42,7 +43,7 @@ double field_value(const MotorRecord& r, MotorField field) noexcept {
   }
 }
 
-void set_field(MotorRecord& r, MotorField field, double value) noexcept {
+void set_field(MotorRecord& r, MotorField field, Real value) noexcept {
   switch (field) {
     case MotorField::rated_voltage_V: r.nameplate.rated_voltage_V = value; break;
     case MotorField::rated_current_A: r.nameplate.rated_current_A = value; break;
@@ -55,17 +56,17 @@ void set_field(MotorRecord& r, MotorField field, double value) noexcept {
   }
 }
 
-ParameterStatus check_field(MotorField field, double value) noexcept {
+ParameterStatus check_field(MotorField field, Real value) noexcept {
   if (!std::isfinite(value)) return ParameterStatus::not_finite;
   if (field == MotorField::friction_Nms) {
-    return value < 0.0 ? ParameterStatus::negative : ParameterStatus::ok;
+    return value < 0 ? ParameterStatus::negative : ParameterStatus::ok;
   }
   if (field == MotorField::pole_pairs) {
-    return value == std::round(value) && value >= 1.0 && value <= kMaxPolePairs
+    return value == std::round(value) && value >= 1 && value <= kMaxPolePairs
                ? ParameterStatus::ok
                : ParameterStatus::not_whole;
   }
-  return value > 0.0 ? ParameterStatus::ok : ParameterStatus::not_positive;
+  return value > 0 ? ParameterStatus::ok : ParameterStatus::not_positive;
 }
 
 ParameterStatus check_record(const control::MotorParameters& motor) noexcept {
@@ -86,9 +87,7 @@ std::array<uint8_t, kMotorRecordBytes> encode_motor_record(const MotorRecord& re
   out[2] = kRecordFieldCount;
   out[3] = 0;
   for (int i = 0; i < kRecordFieldCount; ++i) {
-    const double v = field_value(record, static_cast<MotorField>(i));
-    uint64_t bits = 0;
-    std::memcpy(&bits, &v, sizeof bits);
+    const uint64_t bits = record_bits(field_value(record, static_cast<MotorField>(i)));
     for (int b = 0; b < 8; ++b) out[4 + 8 * i + b] = static_cast<uint8_t>(bits >> (8 * b));
   }
   return out;
@@ -102,10 +101,9 @@ std::optional<MotorRecord> decode_motor_record(std::span<const uint8_t> bytes) n
   for (int i = 0; i < kRecordFieldCount; ++i) {
     uint64_t bits = 0;
     for (int b = 0; b < 8; ++b) bits |= uint64_t(bytes[4 + 8 * i + b]) << (8 * b);
-    double v = 0.0;
-    std::memcpy(&v, &bits, sizeof v);
+    const Real v = record_value(bits);
     const auto field = static_cast<MotorField>(i);
-    const bool unset_nameplate = i >= kMotorFieldCount && v == 0.0;
+    const bool unset_nameplate = i >= kMotorFieldCount && v == 0;
     if (!unset_nameplate && check_field(field, v) != ParameterStatus::ok) return std::nullopt;
     set_field(record, field, v);
   }

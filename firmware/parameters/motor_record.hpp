@@ -12,6 +12,7 @@
 #include <span>
 
 #include "control/motor_parameters.hpp"
+#include "control/real.hpp"
 #include "firmware/identification/nameplate.hpp"
 #include "firmware/protocol/messages.hpp"
 
@@ -68,15 +69,15 @@ inline constexpr std::size_t kMotorRecordBytes = 4 + 8 * kRecordFieldCount;
 inline constexpr uint16_t kMotorRecordVersion = 2;
 
 /// A motor field (the first kMotorFieldCount) of the parameters.
-double field_value(const control::MotorParameters& motor, MotorField field) noexcept;
+Real field_value(const control::MotorParameters& motor, MotorField field) noexcept;
 /// Sets a motor field; pole_pairs takes the value rounded (check_field first).
-void set_field(control::MotorParameters& motor, MotorField field, double value) noexcept;
+void set_field(control::MotorParameters& motor, MotorField field, Real value) noexcept;
 /// Any field of the record.
-double field_value(const MotorRecord& record, MotorField field) noexcept;
-void set_field(MotorRecord& record, MotorField field, double value) noexcept;
+Real field_value(const MotorRecord& record, MotorField field) noexcept;
+void set_field(MotorRecord& record, MotorField field, Real value) noexcept;
 
 /// The rule a single value breaks (ok if none). The field must be a valid index.
-ParameterStatus check_field(MotorField field, double value) noexcept;
+ParameterStatus check_field(MotorField field, Real value) noexcept;
 /// The rule a whole record breaks, as a status: control::find_invalid_parameter's rules.
 ParameterStatus check_record(const control::MotorParameters& motor) noexcept;
 

@@ -10,7 +10,7 @@ uint32_t fields_of(const std::optional<MotorRecord>& loaded) noexcept {
   if (!loaded) return 0u;
   uint32_t fields = (1u << kMotorFieldCount) - 1;
   for (int i = kMotorFieldCount; i < kRecordFieldCount; ++i) {
-    if (field_value(*loaded, MotorField(i)) > 0.0) fields |= 1u << i;
+    if (field_value(*loaded, MotorField(i)) > 0) fields |= 1u << i;
   }
   return fields;
 }
@@ -58,14 +58,14 @@ std::optional<Nameplate> ParameterBank::nameplate() const noexcept {
   return staged_.nameplate;
 }
 
-ParameterStatus ParameterBank::read(uint8_t field, double& value) const noexcept {
+ParameterStatus ParameterBank::read(uint8_t field, Real& value) const noexcept {
   if (field >= kRecordFieldCount) return ParameterStatus::unknown_field;
   if ((set_fields_ & (1u << field)) == 0) return ParameterStatus::not_set;
   value = field_value(staged_, static_cast<MotorField>(field));
   return ParameterStatus::ok;
 }
 
-ParameterStatus ParameterBank::write(uint8_t field, double value, bool at_rest,
+ParameterStatus ParameterBank::write(uint8_t field, Real value, bool at_rest,
                                      bool& changed) noexcept {
   changed = false;
   if (field >= kRecordFieldCount) return ParameterStatus::unknown_field;
@@ -118,7 +118,7 @@ void ParameterBank::serve(hal::ParameterStore* store) noexcept {
     case protocol::ParameterOp::read:
       break;
     case protocol::ParameterOp::write:
-      a.status = write(access_.field, double(access_.value), access_.at_rest, a.apply);
+      a.status = write(access_.field, Real(access_.value), access_.at_rest, a.apply);
       break;
     case protocol::ParameterOp::identify:
     case protocol::ParameterOp::identified:
@@ -134,7 +134,7 @@ void ParameterBank::serve(hal::ParameterStore* store) noexcept {
       }
       break;
   }
-  double value = std::numeric_limits<double>::quiet_NaN();
+  Real value = std::numeric_limits<double>::quiet_NaN();
   const ParameterStatus read_status = read(access_.field, value);
   if (access_.op == protocol::ParameterOp::read) a.status = read_status;
   a.value = read_status == ParameterStatus::ok ? static_cast<float>(value)

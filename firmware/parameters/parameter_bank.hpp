@@ -17,6 +17,7 @@
 #include <optional>
 
 #include "control/motor_parameters.hpp"
+#include "control/real.hpp"
 #include "firmware/parameters/motor_record.hpp"
 #include "firmware/protocol/commands.hpp"
 #include "hal/parameter_store.hpp"
@@ -85,8 +86,8 @@ class ParameterBank {
   static constexpr uint32_t kNameplateFields =
       ((1u << kRecordFieldCount) - 1 - kMotorFields) | (1u << int(MotorField::pole_pairs));
   bool complete() const noexcept { return (set_fields_ & kMotorFields) == kMotorFields; }
-  ParameterStatus read(uint8_t field, double& value) const noexcept;
-  ParameterStatus write(uint8_t field, double value, bool at_rest, bool& changed) noexcept;
+  ParameterStatus read(uint8_t field, Real& value) const noexcept;
+  ParameterStatus write(uint8_t field, Real value, bool at_rest, bool& changed) noexcept;
 
   MotorRecord staged_;
   uint32_t set_fields_;

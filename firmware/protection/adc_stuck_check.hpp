@@ -11,16 +11,17 @@
 #include <cstdint>
 
 #include "control/frames.hpp"
+#include "control/real.hpp"
 
 namespace imd::firmware {
 
 template <typename T>
 class AdcStuckCheck {
  public:
-  AdcStuckCheck(int stuck_ticks, double period_s, double sigma_H, double A_per_code) noexcept
+  AdcStuckCheck(int stuck_ticks, Real period_s, Real sigma_H, Real A_per_code) noexcept
       : stuck_ticks_(stuck_ticks),
         A_per_V_(T(period_s / sigma_H)),
-        evidence_needed_A_(T(4.0 * A_per_code)) {}
+        evidence_needed_A_(T(4 * A_per_code)) {}
 
   void reset() noexcept {
     same_ticks_ = 0;

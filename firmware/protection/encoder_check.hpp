@@ -25,38 +25,40 @@
 #include <cstdint>
 #include <numbers>
 
+#include "control/real.hpp"
+
 namespace imd::firmware {
 
 /// The largest plausible count step: 1.5 x the overspeed limit over one period, plus 2 counts
 /// for the latching instant (no limit for an infinite overspeed).
-inline int32_t max_jump(double overspeed_rad_s, double period_s, double counts_per_rev) noexcept {
-  const double counts =
-      1.5 * overspeed_rad_s * period_s * counts_per_rev / (2.0 * std::numbers::pi);
-  return counts < 1e9 ? static_cast<int32_t>(std::ceil(counts)) + 2 : INT32_MAX;
+inline int32_t max_jump(Real overspeed_rad_s, Real period_s, Real counts_per_rev) noexcept {
+  const Real counts =
+      Real(1.5) * overspeed_rad_s * period_s * counts_per_rev / (2 * std::numbers::pi_v<Real>);
+  return counts < Real(1e9) ? static_cast<int32_t>(std::ceil(counts)) + 2 : INT32_MAX;
 }
 
 template <typename T>
 class EncoderCheck {
  public:
   struct Config {
-    double counts_per_rev = 8192.0;
-    double period_s = 1e-4;
-    double J_kgm2 = 0.01;
-    double friction_Nms = 0.0;
-    double missing_counts = 2.0;
-    double overspeed_rad_s = 400.0;
+    Real counts_per_rev = 8192.0;
+    Real period_s = 1e-4;
+    Real J_kgm2 = 0.01;
+    Real friction_Nms = 0.0;
+    Real missing_counts = 2.0;
+    Real overspeed_rad_s = 400.0;
     /// The speed estimate's error from quantization (control/encoder_quantization_bounds).
-    double speed_error_rad_s = 0.0;
-    double observer_bandwidth_rad_s = 400.0;  ///< the encoder observer's
+    Real speed_error_rad_s = 0.0;
+    Real observer_bandwidth_rad_s = 400.0;  ///< the encoder observer's
   };
 
   explicit EncoderCheck(const Config& c) noexcept
       : period_s_(T(c.period_s)),
         period_per_J_(T(c.period_s / c.J_kgm2)),
         friction_(T(c.friction_Nms)),
-        missing_rad_(T(c.missing_counts * 2.0 * std::numbers::pi / c.counts_per_rev)),
+        missing_rad_(T(c.missing_counts * 2 * std::numbers::pi_v<Real> / c.counts_per_rev)),
         speed_error_rad_s_(T(c.speed_error_rad_s)),
-        lag_per_Nm_(T(1.0 / (c.J_kgm2 * c.observer_bandwidth_rad_s))),
+        lag_per_Nm_(T(Real(1.0) / (c.J_kgm2 * c.observer_bandwidth_rad_s))),
         max_jump_counts_(max_jump(c.overspeed_rad_s, c.period_s, c.counts_per_rev)) {
     reset();
   }

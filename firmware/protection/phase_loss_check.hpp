@@ -17,6 +17,8 @@
 #include <cmath>
 #include <cstdint>
 
+#include "control/real.hpp"
+
 namespace imd::firmware {
 
 template <typename T>
@@ -26,11 +28,11 @@ class PhaseLossCheck {
     uint32_t window_ticks = 1;
     /// The healthy model's largest mean shortfall per tick, per volt of DC bus (the inverter's
     /// voltage error over the leakage inductance), and the noise of the window's mean.
-    double missing_A_per_bus_V = 0.0;
-    double noise_floor_A = 0.0;
+    Real missing_A_per_bus_V = 0.0;
+    Real noise_floor_A = 0.0;
     /// A phase that carries less than this share of its predicted current carries none: an
     /// open phase carries only the measurement noise, a healthy one all of it.
-    double carried_share = 0.5;
+    Real carried_share = 0.5;
   };
 
   explicit PhaseLossCheck(const Config& c) noexcept

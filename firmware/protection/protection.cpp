@@ -22,11 +22,11 @@ uint32_t saturated(uint64_t ticks) noexcept {
 template <typename T>
 typename EncoderCheck<T>::Config encoder_config(const control::MotorParameters& motor,
                                                 const control::VoltageFedCoefficients& c,
-                                                const DriveConfig& config, double counts_per_rev) {
+                                                const DriveConfig& config, Real counts_per_rev) {
   // In the drive's arithmetic: on the MCU the bound's few thousand steps are float, not soft
   // double (control/encoder_observer.hpp raises the float result by a rounding margin).
   const control::QuantizationErrorBounds q = control::encoder_quantization_bounds<T>(
-      c, T(config.encoder_observer_bandwidth_rad_s), T(2.0 * std::numbers::pi / counts_per_rev));
+      c, T(config.encoder_observer_bandwidth_rad_s), T(2 * std::numbers::pi_v<Real> / counts_per_rev));
   return {counts_per_rev,
           config.sample_period_s,
           motor.J_kgm2,
@@ -42,20 +42,20 @@ typename EncoderCheck<T>::Config encoder_config(const control::MotorParameters& 
 template <typename T>
 typename PhaseLossCheck<T>::Config phase_loss_config(const control::MotorParameters& motor,
                                                      const DriveConfig& config,
-                                                     double adc_A_per_code) {
+                                                     Real adc_A_per_code) {
   const control::VoltageFedConstants k = control::derive_voltage_fed(motor);
-  const double period_s = config.sample_period_s;
+  const Real period_s = config.sample_period_s;
   // A window of the transient time constant sigma / (Rs + Rr Lm^2/Lr^2) = 1/gamma: the time
   // the current takes to follow the voltage; at least 4 ticks.
-  const double window = std::max(std::ceil(1.0 / (k.gamma_per_s * period_s)), 4.0);
+  const Real window = std::max(std::ceil(Real(1.0) / (k.gamma_per_s * period_s)), Real(4.0));
   // The mean of (|i_pred| - |i|) over the window: per tick its noise is at most
   // sqrt(2) sigma_adc; six standard deviations of the window's mean.
-  const double noise_A = config.protection.adc_noise_codes * adc_A_per_code;
+  const Real noise_A = config.protection.adc_noise_codes * adc_A_per_code;
   typename PhaseLossCheck<T>::Config c;
   c.window_ticks = static_cast<uint32_t>(window);
   c.missing_A_per_bus_V =
-      config.protection.inverter_voltage_error_share / std::sqrt(3.0) * period_s / k.sigma_H;
-  c.noise_floor_A = 6.0 * std::sqrt(2.0) * noise_A / std::sqrt(window);
+      config.protection.inverter_voltage_error_share / std::sqrt(Real(3.0)) * period_s / k.sigma_H;
+  c.noise_floor_A = 6 * std::sqrt(Real(2.0)) * noise_A / std::sqrt(window);
   return c;
 }
 
@@ -64,13 +64,13 @@ typename PhaseLossCheck<T>::Config phase_loss_config(const control::MotorParamet
 template <typename T>
 MotorChecks<T>::MotorChecks(const control::MotorParameters& motor,
                             const control::VoltageFedCoefficients& c, const DriveConfig& config,
-                            double counts_per_rev, double adc_A_per_code) noexcept
+                            Real counts_per_rev, Real adc_A_per_code) noexcept
     : pole_pairs(T(motor.pole_pairs)),
-      torque_per_AWb(T(control::kClarkeTorqueFactor * motor.pole_pairs * motor.Lm_H / motor.Lr_H)),
+      torque_per_AWb(T(control::kClarkeTorqueFactor * Real(motor.pole_pairs) * motor.Lm_H / motor.Lr_H)),
       max_load_share(T(config.protection.encoder_max_load_share)),
       torque_limit_Nm(T(config.torque_limit_Nm)),
       current_limit_A(T(config.current_margin * config.i_max_A)),
-      per_Lm_H(T(1.0 / motor.Lm_H)),
+      per_Lm_H(T(Real(1.0) / motor.Lm_H)),
       encoder(encoder_config<T>(motor, c, config, counts_per_rev)),
       adc_stuck(config.protection.adc_stuck_ticks, config.sample_period_s,
                 control::derive_voltage_fed(motor).sigma_H, adc_A_per_code),
@@ -91,8 +91,9 @@ Protection<T>::Protection(const DriveConfig& config) noexcept
 
 template <typename T>
 void Protection<T>::set_clock(uint32_t clock_Hz) noexcept {
-  const double counts = double(config_.tick_budget_ns) * 1e-9 * double(clock_Hz);
-  budget_counts_ = counts < 4e9 ? static_cast<uint32_t>(std::llround(counts)) : UINT32_MAX;
+  const Real counts = Real(config_.tick_budget_ns) * Real(1e-9) * Real(clock_Hz);
+  // Rounded by a 32-bit conversion: a float's 64-bit one (llround) is soft double on the MCU.
+  budget_counts_ = counts < Real(4e9) ? static_cast<uint32_t>(counts + Real(0.5)) : UINT32_MAX;
 }
 
 template <typename T>

@@ -17,6 +17,7 @@
 #include <cstdint>
 
 #include "control/motor_parameters.hpp"
+#include "control/real.hpp"
 #include "control/voltage_fed_model.hpp"
 #include "firmware/drive_config.hpp"
 #include "firmware/laws/control_law.hpp"
@@ -55,7 +56,7 @@ struct MotorChecks {
   /// `c`: the motor's exact model at the sample period; `counts_per_rev`, `adc_A_per_code`:
   /// the board's encoder and ADC.
   MotorChecks(const control::MotorParameters& motor, const control::VoltageFedCoefficients& c,
-              const DriveConfig& config, double counts_per_rev, double adc_A_per_code) noexcept;
+              const DriveConfig& config, Real counts_per_rev, Real adc_A_per_code) noexcept;
   void reset() noexcept {
     encoder.reset();
     idle();

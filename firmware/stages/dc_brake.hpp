@@ -19,6 +19,7 @@
 #include "control/frames.hpp"
 #include "control/ifoc_design.hpp"
 #include "control/motor_parameters.hpp"
+#include "control/real.hpp"
 #include "firmware/drive_config.hpp"
 
 namespace imd::firmware {
@@ -28,25 +29,25 @@ class DcBrake {
  public:
   DcBrake(const control::MotorParameters& m, const DriveConfig& c) noexcept
       : current_A_(T(c.protection.dc_brake_current_share * c.current_margin * c.i_max_A)) {
-    const double bandwidth_rad_s = control::default_current_bandwidth_rad_s(c.sample_period_s);
-    const double sigma_H = control::derive_voltage_fed(m).sigma_H;
+    const Real bandwidth_rad_s = control::default_current_bandwidth_rad_s(c.sample_period_s);
+    const Real sigma_H = control::derive_voltage_fed(m).sigma_H;
     kp_V_per_A_ = T(sigma_H * bandwidth_rad_s);
     ki_V_per_A_tick_ = T(m.Rs_Ohm * bandwidth_rad_s * c.sample_period_s);
-    const double tau_r_s = m.Lr_H / m.Rr_Ohm;
-    const double current_A = double(current_A_);
+    const Real tau_r_s = m.Lr_H / m.Rr_Ohm;
+    const Real current_A = Real(current_A_);
     // No current (no current limit given): no DC braking.
-    if (std::isfinite(current_A) && current_A > 0.0) {
-      const double k = 1.5 * m.pole_pairs * m.Lm_H * m.Lm_H / m.Lr_H;
+    if (std::isfinite(current_A) && current_A > 0) {
+      const Real k = Real(1.5) * Real(m.pole_pairs) * m.Lm_H * m.Lm_H / m.Lr_H;
       ticks_per_unit_ =
-          T(m.J_kgm2 / (k * current_A * current_A * m.pole_pairs * tau_r_s) / c.sample_period_s);
+          T(m.J_kgm2 / (k * current_A * current_A * Real(m.pole_pairs) * tau_r_s) / c.sample_period_s);
     } else {
       current_A_ = T(0);
     }
-    x_per_rad_s_ = T(m.pole_pairs * tau_r_s);
-    x_stop_ = T(m.pole_pairs * tau_r_s * c.stop_speed_rad_s);
-    settle_ticks_ = T(3.0 * tau_r_s / c.sample_period_s);
-    const double max_ticks = c.stop_timeout_s / c.sample_period_s;
-    max_ticks_ = T(max_ticks < 1e7 ? max_ticks : 1e7);  // within float's integers
+    x_per_rad_s_ = T(Real(m.pole_pairs) * tau_r_s);
+    x_stop_ = T(Real(m.pole_pairs) * tau_r_s * c.stop_speed_rad_s);
+    settle_ticks_ = T(3 * tau_r_s / c.sample_period_s);
+    const Real max_ticks = c.stop_timeout_s / c.sample_period_s;
+    max_ticks_ = T(max_ticks < Real(1e7) ? max_ticks : Real(1e7));  // within float's integers
   }
 
   /// Starts braking from the speed at detection: the ticks it lasts, 0 if it cannot brake

@@ -14,6 +14,7 @@
 /// it (docs/identification.md). Tick context except construction.
 #include <algorithm>
 
+#include "control/real.hpp"
 #include "control/svpwm.hpp"
 #include "hal/pwm.hpp"
 
@@ -24,10 +25,10 @@ class DeadTimeCompensation {
  public:
   /// `dead_time_s`: what the board programs per edge (0 or `enabled` false: no compensation);
   /// `sigma_H`: the motor's stator transient inductance; `period_s`: the PWM period.
-  DeadTimeCompensation(bool enabled, double dead_time_s, double period_s, double sigma_H) noexcept
-      : active_(enabled && dead_time_s > 0.0),
+  DeadTimeCompensation(bool enabled, Real dead_time_s, Real period_s, Real sigma_H) noexcept
+      : active_(enabled && dead_time_s > 0),
         dead_time_share_(T(dead_time_s / period_s)),
-        band_A_per_V_(T(period_s / (12.0 * sigma_H))) {}
+        band_A_per_V_(T(period_s / (12 * sigma_H))) {}
 
   bool active() const noexcept { return active_; }
 

@@ -6,6 +6,7 @@
 /// same interface. Tick context except construction.
 #include "control/encoder_observer.hpp"
 #include "control/flux_observer.hpp"
+#include "control/real.hpp"
 #include "control/voltage_fed_model.hpp"
 #include "firmware/stages/measurement.hpp"
 
@@ -60,8 +61,8 @@ class StateEstimator {
 template <typename T>
 class ObserverEstimator final : public StateEstimator<T> {
  public:
-  ObserverEstimator(const control::VoltageFedCoefficients& c, double pole_pairs,
-                    double encoder_bandwidth_rad_s)
+  ObserverEstimator(const control::VoltageFedCoefficients& c, Real pole_pairs,
+                    Real encoder_bandwidth_rad_s)
       : flux_(c),
         encoder_(c, {encoder_bandwidth_rad_s}),
         current_(c),

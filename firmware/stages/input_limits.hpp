@@ -10,6 +10,7 @@
 #include "control/frames.hpp"
 #include "control/input_disk.hpp"
 #include "control/motor_parameters.hpp"
+#include "control/real.hpp"
 #include "control/svpwm.hpp"
 #include "control/voltage_fed_model.hpp"
 #include "firmware/limitation.hpp"
@@ -37,9 +38,9 @@ class InnerFeedback {
 
 struct InputLimitsConfig {
   bool voltage_limited = true;  ///< false only to reproduce the paper (no limit)
-  double modulation_margin = 0.95;
-  double i_max_A = INFINITY;  ///< infinite: no current limit
-  double current_margin = 0.95;
+  Real modulation_margin = Real(0.95);
+  Real i_max_A = INFINITY;  ///< infinite: no current limit
+  Real current_margin = Real(0.95);
 };
 
 template <typename T>

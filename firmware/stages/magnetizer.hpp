@@ -22,7 +22,7 @@ class Magnetizer {
              const DriveConfig& config) noexcept
       : current_loop_(c),
         current_A_(T(config.magnetizing_current_A)),
-        current_max_A_(T(0.9 * config.i_max_A)),
+        current_max_A_(T(Real(0.9) * config.i_max_A)),
         current_limited_(std::isfinite(config.i_max_A)),
         magnetized_fraction_(T(config.magnetized_fraction)),
         Lm_H_(T(motor.Lm_H)),

@@ -4,6 +4,7 @@
 /// (hal_sim/drive/ideal_sensors.hpp) through the same interface. Tick context.
 #include <cstdint>
 
+#include "control/real.hpp"
 #include "firmware/stages/measurement.hpp"
 #include "hal/current_adc.hpp"
 #include "hal/encoder.hpp"
@@ -25,7 +26,7 @@ class Sensing {
 
 struct SensingConfig {
   int adc_calibration_ticks = 256;  ///< 0: nominal offsets, no calibration
-  double adc_offset_limit_A = 0.5;  ///< a larger measured offset is a fault
+  Real adc_offset_limit_A = 0.5;  ///< a larger measured offset is a fault
 };
 
 /// The board's ADC and encoder: offset calibration and scaling, encoder unwrapping.

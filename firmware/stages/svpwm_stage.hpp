@@ -7,6 +7,7 @@
 /// (dead_time_compensation.hpp). Tick context except construction.
 #include <cmath>
 
+#include "control/real.hpp"
 #include "control/svpwm.hpp"
 #include "firmware/stages/dead_time_compensation.hpp"
 #include "firmware/stages/input_limits.hpp"
@@ -18,7 +19,7 @@ namespace imd::firmware {
 template <typename T>
 class SvpwmStage final : public PowerStage<T> {
  public:
-  SvpwmStage(hal::Pwm& pwm, const control::MotorParameters& motor, double period_s,
+  SvpwmStage(hal::Pwm& pwm, const control::MotorParameters& motor, Real period_s,
              const DeadTimeCompensation<T>& dead_time) noexcept
       : pwm_(pwm), feedback_(motor), dead_time_(dead_time), half_period_s_(T(period_s / 2)) {}
 

@@ -84,7 +84,7 @@ firmware::DriveConfig drive_config(const Scenario& s) {
       set.inverter_voltage_error_share.value_or(p.inverter_voltage_error_share);
   // The board's ADC noise, if it is more than the drive's default assumes.
   p.adc_noise_codes =
-      set.adc_noise_codes.value_or(std::max(p.adc_noise_codes, s.adc.noise_A / A_per_code));
+      set.adc_noise_codes.value_or(std::max(p.adc_noise_codes, Real(s.adc.noise_A / A_per_code)));
   p.command_timeout_s = set.command_timeout_s.value_or(p.command_timeout_s);
   const auto stop = [](const std::string& name) {
     using firmware::StopCategory;

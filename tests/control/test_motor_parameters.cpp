@@ -53,6 +53,11 @@ TEST(MotorParameters, ValidMotorsPass) {
   for (const auto& motor : test::test_motors()) {
     EXPECT_FALSE(find_invalid_parameter(motor.parameters).has_value()) << motor.name;
   }
+  // The least leakage is a bound, not a band: 1.5e-3 passes.
+  MotorParameters m = kPaper000;
+  m.Ls_H = m.Lr_H = 0.5;
+  m.Lm_H = 0.5 * std::sqrt(1 - 1.5e-3);
+  EXPECT_FALSE(find_invalid_parameter(m).has_value());
 }
 
 TEST(MotorParameters, EachRuleNamesItsKey) {
@@ -74,10 +79,13 @@ TEST(MotorParameters, EachRuleNamesItsKey) {
        "must be finite"},
       {[](MotorParameters& m) { m.friction_Nms = std::numeric_limits<double>::infinity(); },
        "friction_Nms", "must be finite"},
-      {[](MotorParameters& m) { m.Lm_H = 0.41; }, "Lm_H", "must satisfy Lm_H^2 < Ls_H * Lr_H"},
+      {[](MotorParameters& m) { m.Lm_H = 0.41; }, "Lm_H", "must satisfy Lm_H^2 <= 0.999 Ls_H * Lr_H"},
       // Equality is rejected too: sigma would be exactly zero.
       {[](MotorParameters& m) { m.Ls_H = m.Lr_H = m.Lm_H = 0.5; }, "Lm_H",
-       "must satisfy Lm_H^2 < Ls_H * Lr_H"},
+       "must satisfy Lm_H^2 <= 0.999 Ls_H * Lr_H"},
+      // A leakage factor of 5e-4, half the least one: a rounding away from none.
+      {[](MotorParameters& m) { m.Ls_H = m.Lr_H = 0.5, m.Lm_H = 0.5 * std::sqrt(1 - 5e-4); },
+       "Lm_H", "must satisfy Lm_H^2 <= 0.999 Ls_H * Lr_H"},
   };
   for (const Case& c : cases) {
     MotorParameters m = kPaper000;

@@ -87,7 +87,7 @@ TEST(MotorFile, EachBadInputHasItsOwnMessage) {
       {with_line("friction_Nms", "friction_Nms = -0.5"),
        "test.toml: motor.friction_Nms = -0.5: must be >= 0"},
       {with_line("Lm_H", "Lm_H = 0.5"),
-       "test.toml: motor.Lm_H = 0.5: must satisfy Lm_H^2 < Ls_H * Lr_H"},
+       "test.toml: motor.Lm_H = 0.5: must satisfy Lm_H^2 <= 0.999 Ls_H * Lr_H"},
       {with_line("Rs_Ohm", "Rs_Ohm = \"14\""),
        "test.toml: motor.Rs_Ohm must be a number, got a string"},
       {with_line("pole_pairs", "pole_pairs = 1.5"),

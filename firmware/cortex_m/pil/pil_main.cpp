@@ -97,7 +97,7 @@ void wait_for_tick(const cm::TwoStageTick& timer) noexcept {
 /// The plant of the scenario, its rotor resistance at `rr_percent` % of the scenario's.
 control::MotorParameters plant_of(const sim::EmbeddedScenario& s, int rr_percent) noexcept {
   control::MotorParameters plant = s.plant;
-  plant.Rr_Ohm *= double(rr_percent) / 100.0;
+  plant.Rr_Ohm = plant.Rr_Ohm * Real(rr_percent) / 100;
   return plant;
 }
 

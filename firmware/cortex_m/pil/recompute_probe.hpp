@@ -40,7 +40,7 @@ inline constexpr uint32_t kGuardBytes = 64;
 
 /// One recompute of the voltage-fed coefficients.
 [[gnu::noinline]] inline void recompute(const control::MotorParameters& motor,
-                                        double delta_s) noexcept {
+                                        Real delta_s) noexcept {
   const control::VoltageFedCoefficients c = control::discretize_voltage_fed<float>(motor, delta_s);
   asm volatile("" : : "r"(&c) : "memory");  // keep the result
 }
@@ -50,7 +50,7 @@ inline constexpr uint32_t kGuardBytes = 64;
 /// Measures `runs` recomputes of the voltage-fed discretization in float at sample period
 /// `delta_s`, each for a rotor resistance 1 % apart. Not for tick context.
 inline RecomputeCost measure_recompute(const mps2::FreeRunningTimer& clock,
-                                       const control::MotorParameters& motor, double delta_s,
+                                       const control::MotorParameters& motor, Real delta_s,
                                        uint32_t runs) noexcept {
   namespace d = recompute_detail;
   RecomputeCost cost;
@@ -65,7 +65,7 @@ inline RecomputeCost measure_recompute(const mps2::FreeRunningTimer& clock,
   cost.stack_bytes = sp - static_cast<uint32_t>(reinterpret_cast<uintptr_t>(word));
   control::MotorParameters m = motor;
   for (uint32_t k = 0; k < runs; ++k) {
-    m.Rr_Ohm = motor.Rr_Ohm * (1.0 + 0.01 * double(k));
+    m.Rr_Ohm = motor.Rr_Ohm * (1 + Real(0.01) * Real(k));
     const uint32_t start = clock.counts();
     d::recompute(m, delta_s);
     cost.counts_total += clock.counts() - start;

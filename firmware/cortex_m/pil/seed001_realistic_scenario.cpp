@@ -4,6 +4,10 @@
 
 #include "hal_sim/drive/embedded_scenario.hpp"
 
+// The values are the file's, in double. The drive's parameters are in its design arithmetic
+// (float on the MCU: control/real.hpp), and each is rounded to it once, as it is assigned.
+#pragma GCC diagnostic ignored "-Wfloat-conversion"
+
 namespace imd::firmware {
 
 extern const sim::EmbeddedScenario kSeed001Realistic;

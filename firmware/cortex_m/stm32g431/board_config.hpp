@@ -6,6 +6,7 @@
 #include <cstdint>
 
 #include "control/motor_parameters.hpp"
+#include "control/real.hpp"
 #include "firmware/drive_config.hpp"
 #include "firmware/protocol/messages.hpp"
 #include "hal/cortex_m/stm32g4/adc_injected.hpp"
@@ -22,10 +23,10 @@ namespace imd::firmware::stm32g431 {
 namespace g4 = hal::cortex_m::stm32g4;
 
 // Power stage ratings (what the inverter board must provide, docs/porting.md).
-inline constexpr double kBusNominal_V = 311.0;  ///< rectified 220 V mains
-inline constexpr double kBusCapacitorRating_V = 450.0;
-inline constexpr double kCurrentRange_A = 10.0;  ///< +- full scale of the current sensing
-inline constexpr double kCurrentLimit_A = 6.0;   ///< motor and inverter limit the law plans for
+inline constexpr Real kBusNominal_V = 311.0;  ///< rectified 220 V mains
+inline constexpr Real kBusCapacitorRating_V = 450.0;
+inline constexpr Real kCurrentRange_A = 10.0;  ///< +- full scale of the current sensing
+inline constexpr Real kCurrentLimit_A = 6.0;   ///< motor and inverter limit the law plans for
 
 // Carrier and control rate.
 inline constexpr uint32_t kPwmFrequency_Hz = 10'000;
@@ -104,32 +105,32 @@ inline constexpr std::array<g4::PinConfig, 11> kOtherPins{{
 /// (hal_sim/scenarios/seed000_realistic.toml), references and enable from CAN.
 constexpr DriveConfig drive_config() {
   DriveConfig c;
-  c.sample_period_s = kControlPeriod_ns * 1e-9;
+  c.sample_period_s = Real(kControlPeriod_ns * 1e-9);
   c.controller = ControllerKind::dsmc;
   c.pwm_latency_ticks = 1;  // duties act from the next carrier peak (tim1_pwm.hpp)
   c.compensate_latency = true;
-  c.speed_reaching_pole = 0.98;
-  c.flux_reaching_pole = 0.98;
+  c.speed_reaching_pole = Real(0.98);
+  c.flux_reaching_pole = Real(0.98);
   c.i_max_A = kCurrentLimit_A;
-  c.dead_time_s = kDeadTime_ns * 1e-9;  // what TIM1's BDTR programs, compensated in the duties
+  c.dead_time_s = Real(kDeadTime_ns * 1e-9);  // what TIM1's BDTR programs, compensated in the duties
   c.max_accel_rad_s2 = 200.0;  // set_speed steps from CAN are ramped
   c.encoder_observer_bandwidth_rad_s = 400.0;
-  c.adc_offset_limit_A = 0.02 * kCurrentRange_A;
+  c.adc_offset_limit_A = Real(0.02 * kCurrentRange_A);
   c.node_id = 1;
   c.commands_over_can = true;
   c.auto_enable = false;
   c.telemetry_rate_Hz = 100;
-  c.flux2_ref_Wb2 = 0.2;
-  c.max_flux2_Wb2 = 0.4;
+  c.flux2_ref_Wb2 = Real(0.2);
+  c.max_flux2_Wb2 = Real(0.4);
   c.enable_input_line = kLineEnable;
   c.fault_output_line = kLineFault;
   c.timing_output_line = kLineTiming;
   ProtectionConfig& p = c.protection;
   p.overcurrent_A = 0.9 * kCurrentRange_A;  // 9 A: 1.5 x the limit, inside the range
-  p.bus_min_V = 0.7 * kBusNominal_V;        // 218 V while enabled
+  p.bus_min_V = Real(0.7 * kBusNominal_V);        // 218 V while enabled
   p.bus_max_V = 400.0;                      // margin below the 450 V capacitors
   p.overspeed_rad_s = 400.0;
-  p.command_timeout_s = 0.2;
+  p.command_timeout_s = Real(0.2);
   p.adc_stuck_ticks = adc_stuck_ticks_for(c.sample_period_s);
   // 80 % of the period: the rest is sampling, CAN and margin.
   p.tick_budget_ns = kControlPeriod_ns / 5 * 4;
