@@ -192,7 +192,7 @@ TEST(DriveIdentification, AllowedToTurnItMeasuresTheMechanicsToo) {
   const InertiaIdentifier<double> test_point(
       InertiaSettings<double>(plan_inertia_test({400.0, 1.9, 50.0, 2},
                                                 IdentifyRig::config().i_max_A, 540.0, 1e-4,
-                                                rig.board.config().encoder_cpr)),
+                                                Real(rig.board.config().encoder_cpr))),
       electrical);
   EXPECT_LT(relative_error(m.J_kgm2, truth.J_kgm2), 0.10);
   EXPECT_NEAR(

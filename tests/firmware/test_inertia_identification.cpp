@@ -75,7 +75,7 @@ void identify_and_check(const Case& c, const char* precision) {
   const control::MotorParameters truth = motor_named(c.motor);
   const sim::SimBoardConfig b = rotating_board(c);
   Rig<T> rig(truth, b, plan_identification(c.nameplate, c.i_max_A, c.v_bus_V, b.period_s),
-             plan_inertia_test(c.nameplate, c.i_max_A, c.v_bus_V, b.period_s, b.encoder_cpr));
+             plan_inertia_test(c.nameplate, c.i_max_A, c.v_bus_V, b.period_s, Real(b.encoder_cpr)));
   run(rig);
   ASSERT_TRUE(rig.commissioning.succeeded()) << "failure " << int(rig.commissioning.failure_code());
   const auto mechanics = rig.commissioning.mechanics();
@@ -120,7 +120,7 @@ TEST(InertiaIdentification, AShaftThatDoesNotTurnSkipsTheStep) {
   control::MotorParameters heavy = motor_named(c.motor);
   heavy.J_kgm2 *= 1000.0;
   const sim::SimBoardConfig b = rotating_board(c);
-  InertiaPlan ip = plan_inertia_test(c.nameplate, c.i_max_A, c.v_bus_V, b.period_s, b.encoder_cpr);
+  InertiaPlan ip = plan_inertia_test(c.nameplate, c.i_max_A, c.v_bus_V, b.period_s, Real(b.encoder_cpr));
   ip.max_accelerate_s = 2.0;
   Rig<double> rig(heavy, b, plan_identification(c.nameplate, c.i_max_A, c.v_bus_V, b.period_s), ip);
   run(rig);
@@ -137,7 +137,7 @@ TEST(InertiaIdentification, AnEncoderCountingBackwardsIsNamed) {
   const sim::SimBoardConfig b = rotating_board(c);
   Rig<float> rig(motor_named(c.motor), b,
                  plan_identification(c.nameplate, c.i_max_A, c.v_bus_V, b.period_s),
-                 plan_inertia_test(c.nameplate, c.i_max_A, c.v_bus_V, b.period_s, b.encoder_cpr));
+                 plan_inertia_test(c.nameplate, c.i_max_A, c.v_bus_V, b.period_s, Real(b.encoder_cpr)));
   rig.encoder_sign = -1;
   run(rig);
   EXPECT_FALSE(rig.commissioning.succeeded());
@@ -156,7 +156,7 @@ TEST(InertiaIdentification, AShaftDrivenByItsLoadIsLeftWithThePwmOff) {
   const sim::SimBoardConfig b = rotating_board(c);
   Rig<float> rig(motor_named(c.motor), b,
                  plan_identification(c.nameplate, c.i_max_A, c.v_bus_V, b.period_s),
-                 plan_inertia_test(c.nameplate, c.i_max_A, c.v_bus_V, b.period_s, b.encoder_cpr));
+                 plan_inertia_test(c.nameplate, c.i_max_A, c.v_bus_V, b.period_s, Real(b.encoder_cpr)));
   while (!rig.commissioning.finished() && rig.commissioning.rotating() == nullptr) {
     rig.board.run_tick();  // the standstill steps, unloaded
   }
@@ -185,7 +185,7 @@ TEST(InertiaIdentification, AWrongPolePairCountStallsAndIsNamed) {
     Rig<float> rig(motor_named(c.motor), b,
                    plan_identification(c.nameplate, c.i_max_A, c.v_bus_V, b.period_s),
                    plan_inertia_test(c.nameplate, c.i_max_A, c.v_bus_V, b.period_s,
-                                     b.encoder_cpr));
+                                     Real(b.encoder_cpr)));
     run(rig);
     EXPECT_FALSE(rig.commissioning.succeeded()) << "seed " << seed;
     EXPECT_EQ(rig.commissioning.failure_code(), 11) << "seed " << seed;  // stalled

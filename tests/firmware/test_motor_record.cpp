@@ -31,9 +31,10 @@ TEST(MotorRecord, TheNameplateTravelsWithTheMotorAndMayBeMissing) {
   const auto back = decode_motor_record(encode_motor_record(r));
   ASSERT_TRUE(back.has_value());
   EXPECT_EQ(back->nameplate.rated_voltage_V, 400.0);
-  EXPECT_EQ(back->nameplate.rated_current_A, 1.9);
+  // Exactly the value written, in the design arithmetic (float on the MCU).
+  EXPECT_EQ(back->nameplate.rated_current_A, imd::Real(1.9));
   EXPECT_EQ(back->nameplate.rated_frequency_Hz, 50.0);
-  EXPECT_EQ(field_value(*back, MotorField::rated_current_A), 1.9);
+  EXPECT_EQ(field_value(*back, MotorField::rated_current_A), imd::Real(1.9));
   r.nameplate.rated_current_A = -1.0;  // a nameplate value is positive when given
   EXPECT_FALSE(decode_motor_record(encode_motor_record(r)).has_value());
 }

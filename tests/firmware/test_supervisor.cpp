@@ -79,9 +79,12 @@ TEST(Supervisor, TheSpeedReachesTheLawThroughTheRamp) {
   const TickPlan<double> p = b.supervisor.plan(2, b.m, b.e);
   ASSERT_EQ(p.mode, Mode::controlling);
   // Each magnetizing tick restarts the ramp at the estimate; with the PWM latency the input
-  // acts from the next step: now is one ramp step on, next two.
-  EXPECT_NEAR(p.now.omega_mech_rad_s, 2.0 + 0.1, 1e-12);
-  EXPECT_NEAR(p.next.omega_mech_rad_s, 2.0 + 0.2, 1e-12);
+  // acts from the next step: now is one ramp step on, next two. The step is computed in the
+  // design arithmetic (control/real.hpp): the acceleration, the period and their product round
+  // by half an epsilon each, relative; the tick's sums add 1e-12 at most.
+  const double step_rounding = 1.5 * std::numeric_limits<Real>::epsilon();
+  EXPECT_NEAR(p.now.omega_mech_rad_s, 2.0 + 0.1, 0.1 * step_rounding + 1e-12);
+  EXPECT_NEAR(p.next.omega_mech_rad_s, 2.0 + 0.2, 0.2 * step_rounding + 1e-12);
   EXPECT_EQ(p.next.flux2_Wb2, 0.2);
 }
 
