@@ -65,7 +65,7 @@ class IolStage {
   /// Starts the law with this current held (the magnetizing current).
   void start(const control::Vec2<T>& i_held_AB_A) noexcept {
     i_held_ = i_next_ = i_held_AB_A;
-    ticks_ = 0;
+    phase_ = 0;
     flux_s_before_.setZero();
     flux_loop_.reset();
     speed_pi_.reset();
@@ -79,7 +79,10 @@ class IolStage {
                         const Reference<T>& ref_next, T v_max_V,
                         const control::Vec2<T>& i_est_AB_A) noexcept {
     IolTickResult<T> r;
-    if (ticks_++ % ticks_per_period_ == 0) {
+    // The tick's place in the period, counted and wrapped (no 64-bit modulo in the tick).
+    const int phase = phase_;
+    phase_ = phase + 1 == ticks_per_period_ ? 0 : phase + 1;
+    if (phase == 0) {
       // A boundary: the current computed one period ago, u(k-1) = i(t_k), is imposed now and
       // held until the next boundary; the law computes u(k) = i(t_{k+1}) (augmented model (19)).
       i_held_ = i_next_;
@@ -88,7 +91,6 @@ class IolStage {
     // u(k) is known a whole period ahead: it is commanded early enough for the current to be
     // there at the next boundary, 1 + latency ticks early for the deadbeat current loop (which
     // reaches its target one tick after it acts), latency ticks for an ideal current source.
-    const auto phase = int((ticks_ - 1) % uint64_t(ticks_per_period_));
     r.i_held_AB_A = i_held_;
     r.torque_held_back = torque_held_back_;
     r.i_cmd_AB_A = (!r.boundary && ticks_per_period_ - phase <= lead_ticks_) ? i_next_ : i_held_;
@@ -146,7 +148,7 @@ class IolStage {
     i_held_ = old.i_held_;
     i_next_ = old.i_next_;
     flux_s_before_ = old.flux_s_before_;
-    ticks_ = old.ticks_;
+    phase_ = old.phase_;
     torque_held_back_ = old.torque_held_back_;
   }
 
@@ -165,7 +167,7 @@ class IolStage {
   control::Vec2<T> i_held_ = control::Vec2<T>::Zero();  ///< imposed over this period, u(k-1)
   control::Vec2<T> i_next_ = control::Vec2<T>::Zero();  ///< for the next period, u(k)
   control::Vec2<T> flux_s_before_ = control::Vec2<T>::Zero();
-  uint64_t ticks_ = 0;
+  int phase_ = 0;  ///< ticks since the last T0 boundary, 0 at a boundary's tick
   bool torque_held_back_ = false;
 };
 
