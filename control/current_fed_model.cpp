@@ -10,7 +10,7 @@ double phi1(double x) noexcept {
 
 // In double whatever Real is, rounded to Real once (as the voltage-fed reference).
 CurrentFedCoefficients discretize_current_fed(const MotorParameters& motor, Real period_s) {
-  const CurrentFedConstants k = derive_current_fed(motor);
+  const CurrentFedConstantsIn<double> k = derive_current_fed<double>(motor);
   const double eta_per_s = k.eta_per_s, sigma = k.sigma, Ls_H = motor.Ls_H, J_kgm2 = motor.J_kgm2;
   const double friction_per_s = double(motor.friction_Nms) / J_kgm2;  // c / J
   const double T0_s = period_s;
@@ -18,7 +18,7 @@ CurrentFedCoefficients discretize_current_fed(const MotorParameters& motor, Real
   const double speed_decay = std::exp(-friction_per_s * T0_s);
   CurrentFedCoefficients c;
   c.T0_s = period_s;
-  c.eta_per_s = k.eta_per_s;
+  c.eta_per_s = Real(k.eta_per_s);
   c.flux_decay = Real(flux_decay);
   c.flux_from_i_now_H = Real(Ls_H * (1.0 - sigma - flux_decay));
   c.flux_from_i_next_H = Real(Ls_H * sigma);

@@ -15,6 +15,7 @@
 ///   unity to it), and a factor 4 below the speed feedback's bandwidth (14 degrees of phase).
 /// Construction only (in Real: control/real.hpp).
 #include <limits>
+#include <numbers>
 
 #include "control/field_weakening.hpp"
 #include "control/motor_parameters.hpp"

@@ -4,25 +4,6 @@
 
 namespace imd::control {
 
-VoltageFedConstants derive_voltage_fed(const MotorParameters& m) noexcept {
-  VoltageFedConstants c;
-  c.sigma_H = m.Ls_H - m.Lm_H * m.Lm_H / m.Lr_H;
-  c.alpha_per_s = m.Rr_Ohm / m.Lr_H;
-  c.beta_per_H = m.Lm_H / (c.sigma_H * m.Lr_H);
-  c.gamma_per_s = m.Lm_H * m.Lm_H * m.Rr_Ohm / (c.sigma_H * m.Lr_H * m.Lr_H) + m.Rs_Ohm / c.sigma_H;
-  c.mu_per_kgm2 = kClarkeTorqueFactor * m.Lm_H * Real(m.pole_pairs) / (m.J_kgm2 * m.Lr_H);
-  return c;
-}
-
-CurrentFedConstants derive_current_fed(const MotorParameters& m) noexcept {
-  CurrentFedConstants c;
-  c.sigma = 1 - m.Lm_H * m.Lm_H / (m.Lr_H * m.Ls_H);
-  c.eta_per_s = m.Rr_Ohm / m.Lr_H;
-  c.zeta_per_H_s = m.Rr_Ohm / (c.sigma * m.Lr_H * m.Ls_H);
-  c.gamma_per_s = (m.Lr_H * m.Rs_Ohm + m.Ls_H * m.Rr_Ohm) / (c.sigma * m.Lr_H * m.Ls_H);
-  return c;
-}
-
 std::optional<ParameterProblem> find_invalid_parameter(const MotorParameters& m) noexcept {
   struct Positive {
     std::string_view key;
@@ -47,7 +28,8 @@ std::optional<ParameterProblem> find_invalid_parameter(const MotorParameters& m)
   // model (1) would divide by zero or run backwards. The bound keeps the leakage factor at
   // kMinLeakageFactor or more, orders of magnitude above the rounding of either arithmetic
   // (a coupling that is "just" leaky by one rounding would divide the designs by it).
-  if (m.Lm_H * m.Lm_H > (1 - kMinLeakageFactor) * m.Ls_H * m.Lr_H) {
+  // As a product of ratios, which neither overflows nor underflows where Lm^2 or Ls Lr would.
+  if ((m.Lm_H / m.Ls_H) * (m.Lm_H / m.Lr_H) > 1 - kMinLeakageFactor) {
     return ParameterProblem{"Lm_H", m.Lm_H, "must satisfy Lm_H^2 <= 0.999 Ls_H * Lr_H"};
   }
   return std::nullopt;

@@ -6,8 +6,10 @@
 /// 000. Paper 001 writes its model with factor 1 (a power-invariant two-phase machine); the
 /// project keeps one convention and carries 3/2 into paper 001's torque (docs/derivations.md,
 /// Conventions).
+#include <cmath>
 #include <optional>
 #include <string_view>
+#include <type_traits>
 
 #include "control/real.hpp"
 
@@ -32,28 +34,75 @@ struct MotorParameters {
   Real friction_Nms = 0.0;  ///< viscous friction c (paper 001); 0 in paper 000
 };
 
-/// Constants of model (1) of paper 000.
-struct VoltageFedConstants {
-  Real sigma_H = 0.0;      ///< sigma = Ls - Lm^2/Lr (stator transient inductance)
-  Real alpha_per_s = 0.0;  ///< alpha = Rr/Lr
-  Real beta_per_H = 0.0;   ///< beta = Lm/(sigma Lr)
-  Real gamma_per_s = 0.0;  ///< gamma = Lm^2 Rr/(sigma Lr^2) + Rs/sigma
-  Real mu_per_kgm2 = 0.0;  ///< mu = 3/2 Lm p/(J Lr)
+/// Constants of model (1) of paper 000, in S (the design arithmetic by default; the double
+/// references and the simulated plant take double whatever Real is).
+template <typename S>
+struct VoltageFedConstantsIn {
+  S sigma_H = 0;      ///< sigma = Ls - Lm^2/Lr (stator transient inductance)
+  S alpha_per_s = 0;  ///< alpha = Rr/Lr
+  S beta_per_H = 0;   ///< beta = Lm/(sigma Lr)
+  S gamma_per_s = 0;  ///< gamma = Lm^2 Rr/(sigma Lr^2) + Rs/sigma
+  S mu_per_kgm2 = 0;  ///< mu = 3/2 Lm p/(J Lr)
 };
+using VoltageFedConstants = VoltageFedConstantsIn<Real>;
 
 /// Constants of model (1) of paper 001 (stator flux and stator current as states).
-struct CurrentFedConstants {
-  Real sigma = 0.0;         ///< leakage factor 1 - m^2/(lr ls), dimensionless
-  Real eta_per_s = 0.0;     ///< eta = rr/lr
-  Real zeta_per_H_s = 0.0;  ///< zeta = rr/(sigma lr ls)
-  Real gamma_per_s = 0.0;   ///< gamma = (lr rs + ls rr)/(sigma lr ls)
+template <typename S>
+struct CurrentFedConstantsIn {
+  S sigma = 0;         ///< leakage factor 1 - m^2/(lr ls), dimensionless
+  S eta_per_s = 0;     ///< eta = rr/lr
+  S zeta_per_H_s = 0;  ///< zeta = rr/(sigma lr ls)
+  S gamma_per_s = 0;   ///< gamma = (lr rs + ls rr)/(sigma lr ls)
 };
+using CurrentFedConstants = CurrentFedConstantsIn<Real>;
 
-/// Paper 000 constants. Requires valid parameters (see find_invalid_parameter).
-VoltageFedConstants derive_voltage_fed(const MotorParameters& motor) noexcept;
+/// sigma Lr Ls = Ls Lr - Lm^2, the leakage product, in S. Lm^2 is within a few percent of Ls Lr,
+/// so the difference loses that factor's digits: in float it is Kahan's fused product
+/// difference, within 2 ulp of the value the parameters give; in double the plain one (its
+/// rounding, 1e-16 times Ls/sigma, is far below any use).
+template <typename S>
+S leakage_product_H2(S Ls_H, S Lr_H, S Lm_H) noexcept {
+  if constexpr (std::is_same_v<S, float>) {
+    const float lm2 = Lm_H * Lm_H;
+    const float lm2_error = std::fma(-Lm_H, Lm_H, lm2);  // lm2 - Lm^2, exactly
+    return std::fma(Ls_H, Lr_H, -lm2) + lm2_error;
+  } else {
+    return Ls_H * Lr_H - Lm_H * Lm_H;
+  }
+}
 
-/// Paper 001 constants. Requires valid parameters (see find_invalid_parameter).
-CurrentFedConstants derive_current_fed(const MotorParameters& motor) noexcept;
+/// Paper 000 constants in S. Requires valid parameters (see find_invalid_parameter).
+template <typename S = Real>
+VoltageFedConstantsIn<S> derive_voltage_fed(const MotorParameters& m) noexcept {
+  const S Ls = S(m.Ls_H), Lm = S(m.Lm_H), Lr = S(m.Lr_H), Rr = S(m.Rr_Ohm), Rs = S(m.Rs_Ohm);
+  VoltageFedConstantsIn<S> c;
+  if constexpr (std::is_same_v<S, float>) {
+    c.sigma_H = leakage_product_H2(Ls, Lr, Lm) / Lr;
+  } else {
+    c.sigma_H = Ls - Lm * Lm / Lr;
+  }
+  c.alpha_per_s = Rr / Lr;
+  c.beta_per_H = Lm / (c.sigma_H * Lr);
+  c.gamma_per_s = Lm * Lm * Rr / (c.sigma_H * Lr * Lr) + Rs / c.sigma_H;
+  c.mu_per_kgm2 = S(kClarkeTorqueFactor) * Lm * S(m.pole_pairs) / (S(m.J_kgm2) * Lr);
+  return c;
+}
+
+/// Paper 001 constants in S. Requires valid parameters (see find_invalid_parameter).
+template <typename S = Real>
+CurrentFedConstantsIn<S> derive_current_fed(const MotorParameters& m) noexcept {
+  const S Ls = S(m.Ls_H), Lm = S(m.Lm_H), Lr = S(m.Lr_H), Rr = S(m.Rr_Ohm), Rs = S(m.Rs_Ohm);
+  CurrentFedConstantsIn<S> c;
+  if constexpr (std::is_same_v<S, float>) {
+    c.sigma = leakage_product_H2(Ls, Lr, Lm) / (Lr * Ls);
+  } else {
+    c.sigma = 1 - Lm * Lm / (Lr * Ls);
+  }
+  c.eta_per_s = Rr / Lr;
+  c.zeta_per_H_s = Rr / (c.sigma * Lr * Ls);
+  c.gamma_per_s = (Lr * Rs + Ls * Rr) / (c.sigma * Lr * Ls);
+  return c;
+}
 
 /// The first parameter that makes a motor invalid, with the rule it breaks.
 struct ParameterProblem {

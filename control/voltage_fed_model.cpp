@@ -8,7 +8,7 @@
 namespace imd::control {
 
 Eigen::Matrix3d voltage_fed_axis_generator(const MotorParameters& motor) {
-  const VoltageFedConstants k = derive_voltage_fed(motor);
+  const VoltageFedConstantsIn<double> k = derive_voltage_fed<double>(motor);
   const double alpha = k.alpha_per_s, beta = k.beta_per_H, gamma = k.gamma_per_s;
   const double sigma = k.sigma_H, Lm = motor.Lm_H;
   Eigen::Matrix3d a;
@@ -29,7 +29,7 @@ Eigen::Matrix3d additive_compound(const Eigen::Matrix3d& a) {
 // The reference computes in double whatever Real is (the processor-in-the-loop image's metrics
 // use it on the MCU too); its results are rounded to Real once, at the end.
 VoltageFedCoefficients discretize_voltage_fed(const MotorParameters& motor, Real period_s) {
-  const double mu_per_kgm2 = derive_voltage_fed(motor).mu_per_kgm2;
+  const double mu_per_kgm2 = derive_voltage_fed<double>(motor).mu_per_kgm2;
   const double J_kgm2 = motor.J_kgm2;
   const double friction_per_s = double(motor.friction_Nms) / J_kgm2;
   const double delta_s = period_s;

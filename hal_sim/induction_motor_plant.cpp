@@ -40,7 +40,7 @@ Vec2 phase_axis(int phase) noexcept {
 
 InductionMotorPlant::InductionMotorPlant(const control::MotorParameters& motor,
                                          const PlantConfig& config)
-    : motor_(motor), k_(control::derive_voltage_fed(motor)), config_(config) {
+    : motor_(motor), k_(control::derive_voltage_fed<double>(motor)), config_(config) {
   assert(config.period_s > 0.0 && config.rk4_substeps >= 1);
 }
 
@@ -48,7 +48,7 @@ void InductionMotorPlant::set_resistances(double Rs_Ohm, double Rr_Ohm) noexcept
   assert(Rs_Ohm > 0.0 && Rr_Ohm > 0.0);
   motor_.Rs_Ohm = Real(Rs_Ohm);
   motor_.Rr_Ohm = Real(Rr_Ohm);
-  k_ = control::derive_voltage_fed(motor_);
+  k_ = control::derive_voltage_fed<double>(motor_);
 }
 
 void InductionMotorPlant::set_open_phases(unsigned mask) noexcept {
@@ -176,7 +176,7 @@ void InductionMotorPlant::step_voltage_segments(const VoltageSegment* segments,
 namespace {
 
 /// Feedback (2): u = sigma p w J (I + beta Phi) + e^{p th J} v~.
-Vec2 feedback_2(const control::VoltageFedConstants& k, int pole_pairs, const Vec2& flux,
+Vec2 feedback_2(const control::VoltageFedConstantsIn<double>& k, int pole_pairs, const Vec2& flux,
                 const Vec2& current, double omega, double theta, const Vec2& v_AB_V) {
   const double p = pole_pairs;
   return k.sigma_H * p * omega * control::J_times<double>(current + k.beta_per_H * flux) +

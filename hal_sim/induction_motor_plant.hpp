@@ -157,7 +157,7 @@ class InductionMotorPlant {
   double shaft_torque_Nm(double omega_rad_s, double load_Nm) const noexcept;
 
   control::MotorParameters motor_;
-  control::VoltageFedConstants k_;
+  control::VoltageFedConstantsIn<double> k_;  ///< in double whatever the designs' arithmetic
   PlantConfig config_;
   PlantState state_;
   double time_s_ = 0.0;

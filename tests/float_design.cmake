@@ -4,6 +4,9 @@
 # too, on two motors and under QEMU; this tier covers the four motors, the sweeps and the fault
 # matrix on the host. A test that checks an exactness only double designs reach skips itself
 # here (tests/float_design_skip.hpp), saying why. Tools and benchmarks are not built.
+imd_add_test(test_motor_parameters unit LIBRARIES imd_control tomlplusplus::tomlplusplus
+             SOURCES control/test_motor_parameters.cpp)
+imd_add_test(test_duration_ticks unit LIBRARIES imd_firmware SOURCES firmware/test_duration_ticks.cpp)
 foreach(name test_drive_tick test_drive_commands test_dead_time test_drive_parameters
              test_drive_identification test_heartbeat_brake)
   imd_add_test(${name} unit LIBRARIES imd_firmware imd_hal_sim SOURCES firmware/${name}.cpp)
@@ -25,6 +28,7 @@ foreach(name test_voltage_fed_scenarios test_current_fed_scenarios test_rotor_re
 endforeach()
 
 set(IMD_FLOAT_DESIGN_TESTS
+    test_motor_parameters test_duration_ticks
     test_drive_tick test_drive_commands test_dead_time test_drive_parameters
     test_drive_identification test_heartbeat_brake test_standstill_identification
     test_inertia_identification test_protection test_supervisor test_protection_checks

@@ -11,9 +11,11 @@
 /// the step and leaves the mechanics unmeasured. Tick context, T = float on the MCU.
 #include <algorithm>
 #include <cstdint>
+#include <numbers>
 
 #include "control/frames.hpp"
 #include "control/real.hpp"
+#include "firmware/duration_ticks.hpp"
 #include "firmware/identification/compensated_sum.hpp"
 #include "firmware/identification/standstill_identifier.hpp"
 
@@ -68,10 +70,11 @@ struct InertiaSettings {
         // At most a twentieth of the sample rate: the 1.5 periods of delay then cost 27 deg.
         crossover_rad_s(
             T(std::min(p.crossover_rad_s, 2 * std::numbers::pi_v<Real> / (20 * p.period_s)))),
-        max_accelerate_ticks(static_cast<uint32_t>(p.max_accelerate_s / p.period_s)),
-        max_coast_ticks(static_cast<uint32_t>(p.max_coast_s / p.period_s)),
-        ramp_ticks(static_cast<uint32_t>(Real(0.05) / p.period_s)),
-        brake_extra_ticks(static_cast<uint32_t>(p.max_brake_extra_s / p.period_s)) {}
+        // Whole ticks by duration_ticks: a plain quotient in float can fall a tick short.
+        max_accelerate_ticks(uint32_t(duration_ticks(p.max_accelerate_s, p.period_s))),
+        max_coast_ticks(uint32_t(duration_ticks(p.max_coast_s, p.period_s))),
+        ramp_ticks(uint32_t(duration_ticks(Real(0.05), p.period_s))),
+        brake_extra_ticks(uint32_t(duration_ticks(p.max_brake_extra_s, p.period_s))) {}
   T period_s, rad_per_count, omega_rated_rad_s, v_phase_peak_V, i_limit_A, v_limit_V;
   T J_guess_kgm2, pole_pairs, accelerate_s, crossover_rad_s;
   uint32_t max_accelerate_ticks, max_coast_ticks, ramp_ticks, brake_extra_ticks;

@@ -12,9 +12,11 @@ namespace {
 
 const MotorParameters kPaper000{14.0, 0.4, 0.377, 10.1, 0.4128, 0.01, 1, 0.0};
 
-// The constants are sums and quotients of a few exactly representable inputs: each result is
-// within a few ulp of the true value, so 1e-14 relative is a safe bound.
-constexpr double kRoundoff = 1e-14;
+// The constants are sums and quotients of a few inputs, each rounded to the design arithmetic
+// Real by half an epsilon; the leakage sigma amplifies that by its conditioning Ls / sigma (7
+// for the paper motor, tens at most for the test motors' identities below) in itself and in
+// every constant that divides by it. 64 epsilons of Real, relative: 1.4e-14 in double.
+constexpr double kRoundoff = 64 * std::numeric_limits<Real>::epsilon();
 
 TEST(MotorParameters, VoltageFedConstantsOfThePaperMotor) {
   // Reference values evaluated independently (Python, double) from the formulas under (1).
@@ -82,6 +84,12 @@ TEST(MotorParameters, EachRuleNamesItsKey) {
       {[](MotorParameters& m) { m.Lm_H = 0.41; }, "Lm_H", "must satisfy Lm_H^2 <= 0.999 Ls_H * Lr_H"},
       // Equality is rejected too: sigma would be exactly zero.
       {[](MotorParameters& m) { m.Ls_H = m.Lr_H = m.Lm_H = 0.5; }, "Lm_H",
+       "must satisfy Lm_H^2 <= 0.999 Ls_H * Lr_H"},
+      // No leakage at inductances whose squares overflow float, or underflow it: the rule
+      // compares ratios, so neither inf > inf nor 0 > 0 lets them through.
+      {[](MotorParameters& m) { m.Ls_H = m.Lr_H = m.Lm_H = 2e19; }, "Lm_H",
+       "must satisfy Lm_H^2 <= 0.999 Ls_H * Lr_H"},
+      {[](MotorParameters& m) { m.Ls_H = m.Lr_H = m.Lm_H = 1e-23; }, "Lm_H",
        "must satisfy Lm_H^2 <= 0.999 Ls_H * Lr_H"},
       // A leakage factor of 5e-4, half the least one: a rounding away from none.
       {[](MotorParameters& m) { m.Ls_H = m.Lr_H = 0.5, m.Lm_H = 0.5 * std::sqrt(1 - 5e-4); },
