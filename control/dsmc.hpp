@@ -27,10 +27,10 @@
 #include <cstdint>
 #include <limits>
 
-#include "control/real.hpp"
-#include "control/voltage_fed_model.hpp"
 #include "control/frames.hpp"
 #include "control/input_disk.hpp"
+#include "control/real.hpp"
+#include "control/voltage_fed_model.hpp"
 
 namespace imd::control {
 

@@ -29,8 +29,7 @@ struct FluxOuterLoopGains {
 };
 
 /// Gains for a double closed-loop pole at exp(-T0 / time_constant_s).
-inline FluxOuterLoopGains place_flux_outer_loop(Real flux_decay, Real T0_s,
-                                                Real time_constant_s) {
+inline FluxOuterLoopGains place_flux_outer_loop(Real flux_decay, Real T0_s, Real time_constant_s) {
   const Real z = std::exp(-T0_s / time_constant_s);
   return {1 + flux_decay - 2 * z, (1 - z) * (1 - z)};
 }

@@ -11,13 +11,13 @@ IfocGains design_ifoc(const MotorParameters& motor, const IfocSpec& spec) {
   const Real T = spec.sample_period_s;
   IfocGains g;
   g.sample_period_s = T;
-  g.current_bandwidth_rad_s = spec.current_bandwidth_rad_s > 0
-                                  ? spec.current_bandwidth_rad_s
-                                  : default_current_bandwidth_rad_s(T);
-  g.speed_bandwidth_rad_s = spec.speed_bandwidth_rad_s > 0
-                                ? spec.speed_bandwidth_rad_s
-                                : default_speed_bandwidth_rad_s(
-                                      g.current_bandwidth_rad_s, spec.speed_feedback_bandwidth_rad_s);
+  g.current_bandwidth_rad_s = spec.current_bandwidth_rad_s > 0 ? spec.current_bandwidth_rad_s
+                                                               : default_current_bandwidth_rad_s(T);
+  g.speed_bandwidth_rad_s =
+      spec.speed_bandwidth_rad_s > 0
+          ? spec.speed_bandwidth_rad_s
+          : default_speed_bandwidth_rad_s(g.current_bandwidth_rad_s,
+                                          spec.speed_feedback_bandwidth_rad_s);
 
   // One axis after the feed-forward: i(k+1) = a i(k) + b u(k).
   const Real a = std::exp(-k.gamma_per_s * T);

@@ -25,11 +25,12 @@ namespace imd::control {
 
 struct IfocSpec {
   Real sample_period_s = Real(1e-4);
-  Real current_bandwidth_rad_s = 0.0;  ///< 0: f_s / 20 in rad/s
-  Real speed_bandwidth_rad_s = 0.0;    ///< 0: min(w_c / 10, w_obs / 4)
+  Real current_bandwidth_rad_s = 0.0;           ///< 0: f_s / 20 in rad/s
+  Real speed_bandwidth_rad_s = 0.0;             ///< 0: min(w_c / 10, w_obs / 4)
   Real speed_feedback_bandwidth_rad_s = 400.0;  ///< w_obs: the speed estimate's bandwidth
   Real torque_limit_Nm = 240.0;
-  Real current_limit_A = std::numeric_limits<Real>::max();  ///< |i| the law plans for (the other laws' margin applied)
+  Real current_limit_A =
+      std::numeric_limits<Real>::max();  ///< |i| the law plans for (the other laws' margin applied)
   /// Share of the voltage disk the steady state may use in field weakening; the rest is left
   /// to the current loops' transients (control/field_weakening.hpp).
   Real field_weakening_voltage_share = kFieldWeakeningVoltageShare;
@@ -45,10 +46,10 @@ struct IfocGains {
   Real current_pole = 0.0;        ///< e^{-w_c T}: the designed closed-loop pole
   SpeedPiConfig speed;
   // The model the controller holds (its own rotor time constant: a mismatch shows here).
-  Real sigma_H = 0.0;        ///< sigma Ls, the transient inductance
-  Real gamma_per_s = 0.0;    ///< 1 / stator transient time constant
+  Real sigma_H = 0.0;           ///< sigma Ls, the transient inductance
+  Real gamma_per_s = 0.0;       ///< 1 / stator transient time constant
   Real rotor_flux_decay = 0.0;  ///< e^{-T Rr/Lr}
-  Real alpha_per_s = 0.0;    ///< Rr / Lr
+  Real alpha_per_s = 0.0;       ///< Rr / Lr
   Real Lm_H = 0.0, Ls_H = 0.0, Rs_Ohm = 0.0;
   Real Lm_over_Lr = 0.0;
   Real torque_constant_Nm_per_Wb_A = 0.0;  ///< 3/2 p Lm / Lr: T = this psi_r i_q
@@ -66,10 +67,10 @@ constexpr Real default_current_bandwidth_rad_s(Real sample_period_s) noexcept {
   return 2 * std::numbers::pi_v<Real> / (20 * sample_period_s);
 }
 constexpr Real default_speed_bandwidth_rad_s(Real current_bandwidth_rad_s,
-                                               Real speed_feedback_bandwidth_rad_s) noexcept {
-  return current_bandwidth_rad_s / Real(10.0) < speed_feedback_bandwidth_rad_s / Real(4.0)
-             ? current_bandwidth_rad_s / Real(10.0)
-             : speed_feedback_bandwidth_rad_s / Real(4.0);
+                                             Real speed_feedback_bandwidth_rad_s) noexcept {
+  return current_bandwidth_rad_s / 10 < speed_feedback_bandwidth_rad_s / 4
+             ? current_bandwidth_rad_s / 10
+             : speed_feedback_bandwidth_rad_s / 4;
 }
 
 /// The gains for a valid motor and spec (sample period > 0).

@@ -9,9 +9,9 @@
 #include <Eigen/Core>
 #include <complex>
 
+#include "control/frames.hpp"
 #include "control/real.hpp"
 #include "control/voltage_fed_model.hpp"
-#include "control/frames.hpp"
 
 namespace imd::control {
 
@@ -22,8 +22,7 @@ struct LoadEstimatorGains {
 
 /// Gains that give the error matrix of (13) the poles z1, z2 (real, |z| < 1):
 /// trace 1 - l1 = z1 + z2 and determinant -l1 + g l2 = z1 z2.
-inline LoadEstimatorGains place_load_estimator(const VoltageFedCoefficients& c, Real z1,
-                                               Real z2) {
+inline LoadEstimatorGains place_load_estimator(const VoltageFedCoefficients& c, Real z1, Real z2) {
   LoadEstimatorGains gains;
   gains.l1 = 1 - (z1 + z2);
   gains.l2 = (z1 * z2 + gains.l1) / c.load_to_omega;

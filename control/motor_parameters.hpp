@@ -24,14 +24,14 @@ inline constexpr Real kClarkeTorqueFactor = 1.5;
 
 /// Per-phase equivalent-circuit parameters of the motor and its rigid mechanical load.
 struct MotorParameters {
-  Real Rs_Ohm = 0.0;        ///< stator resistance
-  Real Ls_H = 0.0;          ///< stator self inductance
-  Real Lm_H = 0.0;          ///< mutual inductance (paper 001 writes m)
-  Real Rr_Ohm = 0.0;        ///< rotor resistance, referred to the stator
-  Real Lr_H = 0.0;          ///< rotor self inductance
-  Real J_kgm2 = 0.0;        ///< moment of inertia of rotor and load
+  Real Rs_Ohm = 0.0;          ///< stator resistance
+  Real Ls_H = 0.0;            ///< stator self inductance
+  Real Lm_H = 0.0;            ///< mutual inductance (paper 001 writes m)
+  Real Rr_Ohm = 0.0;          ///< rotor resistance, referred to the stator
+  Real Lr_H = 0.0;            ///< rotor self inductance
+  Real J_kgm2 = 0.0;          ///< moment of inertia of rotor and load
   int pole_pairs = 1;         ///< p (paper 000), n_p (paper 001)
-  Real friction_Nms = 0.0;  ///< viscous friction c (paper 001); 0 in paper 000
+  Real friction_Nms = 0.0;    ///< viscous friction c (paper 001); 0 in paper 000
 };
 
 /// Constants of model (1) of paper 000, in S (the design arithmetic by default; the double
@@ -107,7 +107,7 @@ CurrentFedConstantsIn<S> derive_current_fed(const MotorParameters& m) noexcept {
 /// The first parameter that makes a motor invalid, with the rule it breaks.
 struct ParameterProblem {
   std::string_view key;   ///< key name as in the [motor] table, e.g. "Rs_Ohm"
-  Real value;           ///< the offending value
+  Real value;             ///< the offending value
   std::string_view rule;  ///< the requirement it breaks, e.g. "must be > 0"
 };
 

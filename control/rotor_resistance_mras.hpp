@@ -31,9 +31,9 @@ struct RotorResistanceMrasConfig {
   Real convergence_time_constant_s = 0.0;
   /// Both powers are low-passed alike over this time (0: one rotor time constant).
   Real filter_time_constant_s = 0.0;
-  Real min_slip_tangent = 0.25;                             ///< |x| below: frozen (no excitation)
+  Real min_slip_tangent = 0.25;  ///< |x| below: frozen (no excitation)
   Real min_frequency_rad_s = Real(2.0 * 3.14159265358979 * 2.0);  ///< |w_e| below: frozen
-  Real min_scale = Real(0.3), max_scale = 3;  ///< the estimate stays within these x Rr
+  Real min_scale = Real(0.3), max_scale = Real(3.0);  ///< the estimate stays within these x Rr
 };
 
 template <typename T>
@@ -46,7 +46,7 @@ class RotorResistanceMras {
       : period_s_(T(c.sample_period_s)),
         Lm_H_(T(motor.Lm_H)),
         Lm_over_Lr_(T(motor.Lm_H / motor.Lr_H)),
-        inv_Lr_(T(Real(1.0) / motor.Lr_H)),
+        inv_Lr_(T(1 / motor.Lr_H)),
         sigma_over_T_(T((motor.Ls_H - motor.Lm_H * motor.Lm_H / motor.Lr_H) / c.sample_period_s)),
         p_(T(motor.pole_pairs)),
         filter_(T(c.sample_period_s / filter_s(motor, c))),
@@ -55,7 +55,7 @@ class RotorResistanceMras {
         min_frequency_(T(c.min_frequency_rad_s)),
         Rr_min_Ohm_(T(c.min_scale * nominal_Rr_Ohm)),
         Rr_max_Ohm_(T(c.max_scale * nominal_Rr_Ohm)),
-        inv_nominal_(T(Real(1.0) / nominal_Rr_Ohm)),
+        inv_nominal_(T(1 / nominal_Rr_Ohm)),
         Rr_Ohm_(T(std::clamp(motor.Rr_Ohm, c.min_scale * nominal_Rr_Ohm,
                              c.max_scale * nominal_Rr_Ohm))) {}
 
@@ -63,10 +63,9 @@ class RotorResistanceMras {
   static Real filter_s(const MotorParameters& m, const RotorResistanceMrasConfig& c) noexcept {
     return c.filter_time_constant_s > 0 ? c.filter_time_constant_s : m.Lr_H / m.Rr_Ohm;
   }
-  static Real convergence_s(const MotorParameters& m,
-                              const RotorResistanceMrasConfig& c) noexcept {
+  static Real convergence_s(const MotorParameters& m, const RotorResistanceMrasConfig& c) noexcept {
     return c.convergence_time_constant_s > 0 ? c.convergence_time_constant_s
-                                               : 4 * m.Lr_H / m.Rr_Ohm;
+                                             : 4 * m.Lr_H / m.Rr_Ohm;
   }
 
   T Rr_Ohm() const noexcept { return Rr_Ohm_; }

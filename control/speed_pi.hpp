@@ -21,7 +21,7 @@ struct SpeedPiConfig {
 inline SpeedPiConfig design_speed_pi(Real J_kgm2, Real bandwidth_rad_s, Real torque_limit_Nm,
                                      Real period_s) {
   const Real kp = J_kgm2 * bandwidth_rad_s;
-  return {kp, kp * bandwidth_rad_s / Real(4.0), torque_limit_Nm, period_s};
+  return {kp, kp * bandwidth_rad_s / 4, torque_limit_Nm, period_s};
 }
 
 template <typename T>

@@ -12,7 +12,7 @@ Eigen::Matrix3d voltage_fed_axis_generator(const MotorParameters& motor) {
   const double alpha = k.alpha_per_s, beta = k.beta_per_H, gamma = k.gamma_per_s;
   const double sigma = k.sigma_H, Lm = motor.Lm_H;
   Eigen::Matrix3d a;
-  a << -alpha, alpha * Lm, 0.0,             //
+  a << -alpha, alpha * Lm, 0.0,           //
       alpha * beta, -gamma, 1.0 / sigma,  //
       0.0, 0.0, 0.0;
   return a;

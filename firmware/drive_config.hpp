@@ -44,7 +44,7 @@ struct DriveConfig {
   Real ifoc_speed_bandwidth_rad_s = 0.0;
 
   // Control law.
-  Real max_accel_rad_s2 = std::numeric_limits<double>::infinity();  ///< speed reference ramp
+  Real max_accel_rad_s2 = std::numeric_limits<Real>::infinity();  ///< speed reference ramp
   Real speed_reaching_pole = 0.0;  ///< e_{k+1} = pole e_k; 0 is the paper's deadbeat law
   Real flux_reaching_pole = 0.0;
   /// The DSMC's speed channel: through the torque of the next step (false, the default; its
@@ -56,18 +56,18 @@ struct DriveConfig {
   // Limits.
   bool voltage_limited = true;      ///< false only to reproduce the paper (no limit)
   Real modulation_margin = Real(0.95);  ///< share of the SVPWM linear range the law may use
-  Real i_max_A = std::numeric_limits<double>::infinity();  ///< motor and inverter current limit
-  Real current_margin = Real(0.95);  ///< share of i_max the law may plan for
+  Real i_max_A = std::numeric_limits<Real>::infinity();  ///< motor and inverter current limit
+  Real current_margin = Real(0.95);                      ///< share of i_max the law may plan for
 
   // The inverter.
-  Real dead_time_s = 0.0;  ///< the PWM dead time per switching edge the board programs
+  Real dead_time_s = 0.0;            ///< the PWM dead time per switching edge the board programs
   bool compensate_dead_time = true;  ///< add the dead time's voltage loss back to the duties
 
   // Start-up.
   int adc_calibration_ticks = 256;     ///< offset measurement with the PWM off; 0 skips it
-  Real adc_offset_limit_A = 0.5;     ///< a larger measured offset is a fault
-  Real magnetizing_current_A = 0.0;  ///< 0: sqrt(flux2_ref)/Lm, capped at 0.9 i_max
-  Real magnetized_fraction = Real(0.95);   ///< running once |Phi^|^2 >= this * reference
+  Real adc_offset_limit_A = 0.5;       ///< a larger measured offset is a fault
+  Real magnetizing_current_A = 0.0;    ///< 0: sqrt(flux2_ref)/Lm, capped at 0.9 i_max
+  Real magnetized_fraction = Real(0.95);  ///< running once |Phi^|^2 >= this * reference
   Real magnetizing_timeout_s = 2.0;
 
   // Estimation.
@@ -101,7 +101,7 @@ struct DriveConfig {
   bool auto_enable = false;
   int telemetry_rate_Hz = 100;  ///< fast telemetry, 10..1000
   Real min_flux2_command_Wb2 = Real(0.01);  ///< smallest set_flux accepted (10 x min_flux2_Wb2)
-  Real max_flux2_Wb2 = 4.0;           ///< largest set_flux accepted
+  Real max_flux2_Wb2 = 4.0;                 ///< largest set_flux accepted
   /// Initial references over CAN, before any set_speed or set_flux.
   Real flux2_ref_Wb2 = Real(0.2), stator_flux2_ref_Wb2 = 1.0;
 

@@ -18,8 +18,8 @@ namespace imd::firmware {
 inline uint64_t duration_ticks(Real duration_s, Real period_s) noexcept {
   if (!(duration_s > 0)) return 0;
   const Real quotient = duration_s / period_s;
-  const Real rounding =
-      std::min(Real(0.5), std::max(Real(1e-9), 4 * std::numeric_limits<Real>::epsilon() * quotient));
+  const Real rounding = std::min(
+      Real(0.5), std::max(Real(1e-9), 4 * std::numeric_limits<Real>::epsilon() * quotient));
   const Real ticks = std::ceil(quotient - rounding);
   // Below 2^32 through a 32-bit conversion: a float's 64-bit one is soft double on the MCU.
   if (ticks < Real(4e9)) return static_cast<uint32_t>(ticks);

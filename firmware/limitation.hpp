@@ -50,7 +50,7 @@ inline uint32_t limited_window_ticks(const DriveConfig& config) noexcept {
   const Real bandwidth_rad_s = control::default_speed_bandwidth_rad_s(
       control::default_current_bandwidth_rad_s(config.sample_period_s),
       config.encoder_observer_bandwidth_rad_s);
-  return static_cast<uint32_t>(std::lround(Real(4.0) / (bandwidth_rad_s * config.sample_period_s)));
+  return static_cast<uint32_t>(std::lround(4 / (bandwidth_rad_s * config.sample_period_s)));
 }
 
 class LimitedMonitor {

@@ -45,8 +45,8 @@ template <typename T>
 struct MotorModel {
   /// `nominal_Rr_Ohm`: the motor record's rotor resistance, which bounds the tracked one (0:
   /// m's own).
-  MotorModel(const control::MotorParameters& m, const DriveConfig& config,
-             const BoardScales& board, Real nominal_Rr_Ohm = 0.0)
+  MotorModel(const control::MotorParameters& m, const DriveConfig& config, const BoardScales& board,
+             Real nominal_Rr_Ohm = 0.0)
       : motor(m),
         coefficients(control::discretize_voltage_fed<T>(m, config.sample_period_s)),
         observers(coefficients, Real(m.pole_pairs), config.encoder_observer_bandwidth_rad_s),

@@ -9,9 +9,13 @@
 
 #include "control/real.hpp"
 
-#define IMD_SKIP_IF_FLOAT_DESIGN(reason)                                      \
-  do {                                                                       \
-    if constexpr (!std::is_same_v<::imd::Real, double>) {                    \
-      GTEST_SKIP() << "float designs (IMD_DESIGN_IN_FLOAT): " << (reason);   \
-    }                                                                        \
+/// Whether the designs are in double: a test that checks behaviour and an exactness in one keeps
+/// the behaviour's checks in both builds and puts the exactness's under this.
+inline constexpr bool kDoubleDesigns = std::is_same_v<::imd::Real, double>;
+
+#define IMD_SKIP_IF_FLOAT_DESIGN(reason)                                   \
+  do {                                                                     \
+    if constexpr (!std::is_same_v<::imd::Real, double>) {                  \
+      GTEST_SKIP() << "float designs (IMD_DESIGN_IN_FLOAT): " << (reason); \
+    }                                                                      \
   } while (false)

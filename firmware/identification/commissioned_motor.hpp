@@ -30,7 +30,7 @@ control::MotorParameters commissioned_motor(const StandstillResult<T>& r, const 
   m.pole_pairs = n.pole_pairs;
   if (mechanics) {
     m.J_kgm2 = Real(mechanics->J_kgm2);
-    m.friction_Nms = std::max(Real(0.0), Real(mechanics->friction_Nms));
+    m.friction_Nms = std::max(Real(0), Real(mechanics->friction_Nms));
   } else {
     m.J_kgm2 = before ? before->J_kgm2 : catalogue_inertia_kgm2(n);
     m.friction_Nms = before ? before->friction_Nms : 0;

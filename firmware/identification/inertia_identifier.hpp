@@ -35,7 +35,7 @@ enum class InertiaOutcome : uint8_t {
   stalled,          ///< the speed settled below the test speed (load, or a field not oriented)
 };
 
-/// What the rotating step is planned from besides the standstill result (double, outside the
+/// What the rotating step is planned from besides the standstill result (Real, outside the
 /// tick; the rules are in plan_inertia_test()).
 struct InertiaPlan {
   Real period_s = Real(1e-4);

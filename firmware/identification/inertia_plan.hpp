@@ -1,6 +1,6 @@
 #pragma once
 /// The rotating step's plan from the nameplate and the board (docs/identification.md, "Inertia
-/// and friction"). Construction only (double precision), in the service loop.
+/// and friction"). Construction only (in the design arithmetic Real), in the service loop.
 #include <algorithm>
 #include <cmath>
 #include <numbers>
@@ -16,16 +16,17 @@ namespace imd::firmware {
 /// The rated power is taken as sqrt(3) V I x 0.85 (power factor) x 0.85 (efficiency). It only
 /// sizes the test's torque, and stands in for J when the rotor may not turn.
 inline Real catalogue_inertia_kgm2(const Nameplate& n) {
-  const Real p_kW = std::sqrt(Real(3.0)) * n.rated_voltage_V * n.rated_current_A * Real(0.85) * Real(0.85) / Real(1e3);
+  const Real p_kW =
+      std::sqrt(Real(3.0)) * n.rated_voltage_V * n.rated_current_A * Real(0.85) * Real(0.85) / 1000;
   // P^1.25 = P * P^(1/4): two square roots, not pow (2.9 KB of soft-double code on the MCU).
-  return Real(0.0025) * p_kW * std::sqrt(std::sqrt(p_kW)) * Real(n.pole_pairs) / Real(2.0);
+  return Real(0.0025) * p_kW * std::sqrt(std::sqrt(p_kW)) * Real(n.pole_pairs) / 2;
 }
 
 /// The limits of the test: 0.9 of the smaller of the rated peak current and the board's limit,
 /// the linear SVPWM range of the bus; the rest of the sizing needs the identified motor and is
 /// done by InertiaIdentifier's constructor.
-inline InertiaPlan plan_inertia_test(const Nameplate& n, Real i_max_A, Real v_bus_V,
-                                     Real period_s, Real counts_per_rev) {
+inline InertiaPlan plan_inertia_test(const Nameplate& n, Real i_max_A, Real v_bus_V, Real period_s,
+                                     Real counts_per_rev) {
   InertiaPlan p;
   p.period_s = period_s;
   p.rad_per_count = 2 * std::numbers::pi_v<Real> / counts_per_rev;

@@ -1,7 +1,7 @@
 #pragma once
 /// What a commissioning run starts from: the motor's nameplate, and the test levels, gains and
 /// times of the standstill identification derived from it and from the board by the rules of
-/// docs/identification.md. Construction only (double precision).
+/// docs/identification.md. Construction only (in the design arithmetic Real).
 #include <algorithm>
 #include <cmath>
 #include <numbers>
@@ -20,8 +20,8 @@ struct Nameplate {
 /// The standstill test's parameters (all currents are alpha-axis peaks).
 struct IdentificationPlan {
   Real period_s = Real(1e-4);
-  Real i_low_A = 0.0, i_high_A = 0.0;  ///< the two DC levels
-  Real sigma_Ls_guess_H = 0.0;         ///< the transient inductance expected from the nameplate
+  Real i_low_A = 0.0, i_high_A = 0.0;     ///< the two DC levels
+  Real sigma_Ls_guess_H = 0.0;            ///< the transient inductance expected from the nameplate
   Real kp_Ohm = 0.0, ki_Ohm_per_s = 0.0;  ///< the current loop's PI
   Real v_limit_V = 0.0;                   ///< the loop's output limit (linear SVPWM range)
   Real hf_voltage_V = 0.0;                ///< square-wave amplitude of the sigma Ls step
@@ -30,7 +30,7 @@ struct IdentificationPlan {
   /// Times in ticks (plan_identification sets them from the period; these are 10 kHz's):
   int hf_ticks = 2000;     ///< length of the square-wave injection (0.2 s)
   int window_ticks = 100;  ///< the settling detector's averaging window (10 ms)
-  Real max_level_s = 60.0;  ///< a level that never settles fails the run
+  Real max_level_s = 60.0;        ///< a level that never settles fails the run
   Real ramp_down_s = Real(0.05);  ///< current to zero at the end
 };
 
@@ -63,12 +63,13 @@ inline IdentificationPlan plan_identification(const Nameplate& n, Real i_max_A, 
   p.sigma_Ls_guess_H = Real(0.15) * z_base_Ohm / omega_rated_rad_s;
   const Real omega_c_rad_s = Real(2.0 * std::numbers::pi * 50.0);
   p.kp_Ohm = p.sigma_Ls_guess_H * omega_c_rad_s;
-  p.ki_Ohm_per_s = p.kp_Ohm * omega_c_rad_s / Real(5.0);
+  p.ki_Ohm_per_s = p.kp_Ohm * omega_c_rad_s / 5;
   p.v_limit_V = Real(0.95) * v_bus_V / std::sqrt(Real(3.0));
   const Real ripple_A = Real(0.2) * p.i_high_A;
   p.hf_ripple_A = ripple_A;
-  p.hf_voltage_V = std::min(ripple_A * p.sigma_Ls_guess_H / (Real(p.hf_half_period_ticks) * period_s),
-                            Real(0.3) * p.v_limit_V);
+  p.hf_voltage_V =
+      std::min(ripple_A * p.sigma_Ls_guess_H / (Real(p.hf_half_period_ticks) * period_s),
+               Real(0.3) * p.v_limit_V);
   return p;
 }
 

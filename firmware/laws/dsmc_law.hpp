@@ -46,7 +46,7 @@ class DsmcLaw final : public ControlLaw<T> {
     // The flux loop a decade below the current's, as the speed loop's first bound: the load
     // steps' cross-coupling is then corrected within a few milliseconds (the current disk
     // bounds what a flux step asks of the d current).
-    const Real flux_bandwidth_rad_s = current_bandwidth_rad_s(c.config) / Real(10.0);
+    const Real flux_bandwidth_rad_s = current_bandwidth_rad_s(c.config) / 10;
     d.flux_reaching_pole = std::exp(-flux_bandwidth_rad_s * c.config.sample_period_s);
     // The current approaches its target at the IFOC's current bandwidth, f_s / 20 in rad/s
     // (control/ifoc_design.hpp): pole e^{-pi/10} = 0.73 at any sample rate.

@@ -28,7 +28,7 @@ inline control::IfocSpec ifoc_spec(const DriveConfig& config) noexcept {
   s.speed_feedback_bandwidth_rad_s = config.encoder_observer_bandwidth_rad_s;
   s.torque_limit_Nm = config.torque_limit_Nm;
   s.current_limit_A = std::isfinite(config.i_max_A) ? config.current_margin * config.i_max_A
-                                                     : std::numeric_limits<Real>::max();
+                                                    : std::numeric_limits<Real>::max();
   s.min_flux_Wb = std::sqrt(config.min_flux2_Wb2);
   s.latency_ticks = config.compensate_latency ? config.pwm_latency_ticks : 0;
   return s;

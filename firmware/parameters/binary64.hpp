@@ -63,8 +63,12 @@ constexpr float float_from_binary64(uint64_t bits) noexcept {
 }
 
 /// A parameter's record bits.
-inline uint64_t record_bits(double value) noexcept { return std::bit_cast<uint64_t>(value); }
-inline uint64_t record_bits(float value) noexcept { return binary64_bits(value); }
+inline uint64_t record_bits(double value) noexcept {
+  return std::bit_cast<uint64_t>(value);
+}
+inline uint64_t record_bits(float value) noexcept {
+  return binary64_bits(value);
+}
 
 /// A parameter from its record bits.
 template <typename R = Real>

@@ -14,7 +14,8 @@ Real field_value(const control::MotorParameters& m, MotorField field) noexcept {
     case MotorField::Rr_Ohm: return m.Rr_Ohm;
     case MotorField::Lr_H: return m.Lr_H;
     case MotorField::J_kgm2: return m.J_kgm2;
-    case MotorField::pole_pairs: return Real(m.pole_pairs);
+    case MotorField::pole_pairs:
+      return Real(m.pole_pairs);
     case MotorField::friction_Nms: return m.friction_Nms;
     default: return 0.0;
   }

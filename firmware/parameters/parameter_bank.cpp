@@ -134,7 +134,7 @@ void ParameterBank::serve(hal::ParameterStore* store) noexcept {
       }
       break;
   }
-  Real value = std::numeric_limits<double>::quiet_NaN();
+  Real value = std::numeric_limits<Real>::quiet_NaN();
   const ParameterStatus read_status = read(access_.field, value);
   if (access_.op == protocol::ParameterOp::read) a.status = read_status;
   a.value = read_status == ParameterStatus::ok ? static_cast<float>(value)

@@ -1,7 +1,7 @@
 #pragma once
 /// The motor record as the running drive holds it, and the hand-over between the tick, which
 /// receives CAN parameter accesses and answers them, and the service loop (Drive::service),
-/// which does the work: checking a value against the record's rules (in double precision),
+/// which does the work: checking a value against the record's rules (in Real: float on the MCU),
 /// saving the record, and rebuilding the motor model. None of that runs in the tick.
 ///
 /// One access at a time goes through these stages:

@@ -42,8 +42,8 @@ class EncoderCheck {
  public:
   struct Config {
     Real counts_per_rev = 8192.0;
-    Real period_s = 1e-4;
-    Real J_kgm2 = 0.01;
+    Real period_s = Real(1e-4);
+    Real J_kgm2 = Real(0.01);
     Real friction_Nms = 0.0;
     Real missing_counts = 2.0;
     Real overspeed_rad_s = 400.0;
@@ -58,7 +58,7 @@ class EncoderCheck {
         friction_(T(c.friction_Nms)),
         missing_rad_(T(c.missing_counts * 2 * std::numbers::pi_v<Real> / c.counts_per_rev)),
         speed_error_rad_s_(T(c.speed_error_rad_s)),
-        lag_per_Nm_(T(Real(1.0) / (c.J_kgm2 * c.observer_bandwidth_rad_s))),
+        lag_per_Nm_(T(1 / (c.J_kgm2 * c.observer_bandwidth_rad_s))),
         max_jump_counts_(max_jump(c.overspeed_rad_s, c.period_s, c.counts_per_rev)) {
     reset();
   }

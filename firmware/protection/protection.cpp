@@ -25,8 +25,9 @@ typename EncoderCheck<T>::Config encoder_config(const control::MotorParameters& 
                                                 const DriveConfig& config, Real counts_per_rev) {
   // In the drive's arithmetic: on the MCU the bound's few thousand steps are float, not soft
   // double (control/encoder_observer.hpp raises the float result by a rounding margin).
-  const control::QuantizationErrorBounds q = control::encoder_quantization_bounds<T>(
-      c, T(config.encoder_observer_bandwidth_rad_s), T(2 * std::numbers::pi_v<Real> / counts_per_rev));
+  const control::QuantizationErrorBounds q =
+      control::encoder_quantization_bounds<T>(c, T(config.encoder_observer_bandwidth_rad_s),
+                                              T(2 * std::numbers::pi_v<Real> / counts_per_rev));
   return {counts_per_rev,
           config.sample_period_s,
           motor.J_kgm2,
@@ -47,7 +48,7 @@ typename PhaseLossCheck<T>::Config phase_loss_config(const control::MotorParamet
   const Real period_s = config.sample_period_s;
   // A window of the transient time constant sigma / (Rs + Rr Lm^2/Lr^2) = 1/gamma: the time
   // the current takes to follow the voltage; at least 4 ticks.
-  const Real window = std::max(std::ceil(Real(1.0) / (k.gamma_per_s * period_s)), Real(4.0));
+  const Real window = std::max(std::ceil(1 / (k.gamma_per_s * period_s)), Real(4));
   // The mean of (|i_pred| - |i|) over the window: per tick its noise is at most
   // sqrt(2) sigma_adc; six standard deviations of the window's mean.
   const Real noise_A = config.protection.adc_noise_codes * adc_A_per_code;
@@ -66,11 +67,12 @@ MotorChecks<T>::MotorChecks(const control::MotorParameters& motor,
                             const control::VoltageFedCoefficients& c, const DriveConfig& config,
                             Real counts_per_rev, Real adc_A_per_code) noexcept
     : pole_pairs(T(motor.pole_pairs)),
-      torque_per_AWb(T(control::kClarkeTorqueFactor * Real(motor.pole_pairs) * motor.Lm_H / motor.Lr_H)),
+      torque_per_AWb(
+          T(control::kClarkeTorqueFactor * Real(motor.pole_pairs) * motor.Lm_H / motor.Lr_H)),
       max_load_share(T(config.protection.encoder_max_load_share)),
       torque_limit_Nm(T(config.torque_limit_Nm)),
       current_limit_A(T(config.current_margin * config.i_max_A)),
-      per_Lm_H(T(Real(1.0) / motor.Lm_H)),
+      per_Lm_H(T(1 / motor.Lm_H)),
       encoder(encoder_config<T>(motor, c, config, counts_per_rev)),
       adc_stuck(config.protection.adc_stuck_ticks, config.sample_period_s,
                 control::derive_voltage_fed(motor).sigma_H, adc_A_per_code),

@@ -8,8 +8,6 @@
 #include <cstdint>
 #include <span>
 
-#include "control/real.hpp"
-
 /// Whether the tables keep their documentation text (units and comments, which the DBC and the
 /// protocol page are written from). The bare-metal images build with 0: nothing on the board
 /// reads that text, and it is most of the tables' flash.
@@ -55,7 +53,7 @@ struct Signal {
   float range_min = 0.0f;
   float range_max = 0.0f;
 
-  constexpr Real scale() const noexcept { return Real(scale_num) / Real(scale_den); }
+  constexpr double scale() const noexcept { return double(scale_num) / double(scale_den); }
   constexpr int64_t raw_min() const noexcept {
     return is_signed ? -(int64_t(1) << (length_bits - 1)) : 0;
   }

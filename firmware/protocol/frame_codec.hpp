@@ -3,7 +3,6 @@
 #include <cstdint>
 #include <initializer_list>
 
-#include "control/real.hpp"
 #include "firmware/protocol/messages.hpp"
 #include "hal/can_bus.hpp"
 
@@ -26,9 +25,9 @@ inline hal::CanFrame encode_frame(uint8_t node_id, MessageId id,
 }
 
 /// The physical value of signal `index` of a frame, in double precision (host tools).
-inline Real decode_signal(const hal::CanFrame& frame, const Signal& s) noexcept {
-  if (s.is_float) return Real(get_physical(frame.data, s));
-  return Real(get_raw(frame.data, s)) * s.scale() + Real(s.offset);
+inline double decode_signal(const hal::CanFrame& frame, const Signal& s) noexcept {
+  if (s.is_float) return double(get_physical(frame.data, s));
+  return double(get_raw(frame.data, s)) * s.scale() + double(s.offset);
 }
 
 /// The name of an enumerated raw value, or nullptr.

@@ -37,9 +37,9 @@ class DcBrake {
     const Real current_A = Real(current_A_);
     // No current (no current limit given): no DC braking.
     if (std::isfinite(current_A) && current_A > 0) {
-      const Real k = Real(1.5) * Real(m.pole_pairs) * m.Lm_H * m.Lm_H / m.Lr_H;
-      ticks_per_unit_ =
-          T(m.J_kgm2 / (k * current_A * current_A * Real(m.pole_pairs) * tau_r_s) / c.sample_period_s);
+      const Real k = control::kClarkeTorqueFactor * Real(m.pole_pairs) * m.Lm_H * m.Lm_H / m.Lr_H;
+      ticks_per_unit_ = T(m.J_kgm2 / (k * current_A * current_A * Real(m.pole_pairs) * tau_r_s) /
+                          c.sample_period_s);
     } else {
       current_A_ = T(0);
     }

@@ -63,10 +63,7 @@ class ObserverEstimator final : public StateEstimator<T> {
  public:
   ObserverEstimator(const control::VoltageFedCoefficients& c, Real pole_pairs,
                     Real encoder_bandwidth_rad_s)
-      : flux_(c),
-        encoder_(c, {encoder_bandwidth_rad_s}),
-        current_(c),
-        pole_pairs_(T(pole_pairs)) {}
+      : flux_(c), encoder_(c, {encoder_bandwidth_rad_s}), current_(c), pole_pairs_(T(pole_pairs)) {}
 
   Estimate<T> estimate(const Measurement<T>& m) noexcept override {
     if (m.encoder_first) encoder_.reset(m.theta_encoder_rad);

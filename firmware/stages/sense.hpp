@@ -26,7 +26,7 @@ class Sensing {
 
 struct SensingConfig {
   int adc_calibration_ticks = 256;  ///< 0: nominal offsets, no calibration
-  Real adc_offset_limit_A = 0.5;  ///< a larger measured offset is a fault
+  Real adc_offset_limit_A = 0.5;    ///< a larger measured offset is a fault
 };
 
 /// The board's ADC and encoder: offset calibration and scaling, encoder unwrapping.

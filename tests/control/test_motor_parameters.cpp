@@ -81,7 +81,8 @@ TEST(MotorParameters, EachRuleNamesItsKey) {
        "must be finite"},
       {[](MotorParameters& m) { m.friction_Nms = std::numeric_limits<double>::infinity(); },
        "friction_Nms", "must be finite"},
-      {[](MotorParameters& m) { m.Lm_H = 0.41; }, "Lm_H", "must satisfy Lm_H^2 <= 0.999 Ls_H * Lr_H"},
+      {[](MotorParameters& m) { m.Lm_H = 0.41; }, "Lm_H",
+       "must satisfy Lm_H^2 <= 0.999 Ls_H * Lr_H"},
       // Equality is rejected too: sigma would be exactly zero.
       {[](MotorParameters& m) { m.Ls_H = m.Lr_H = m.Lm_H = 0.5; }, "Lm_H",
        "must satisfy Lm_H^2 <= 0.999 Ls_H * Lr_H"},

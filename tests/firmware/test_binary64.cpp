@@ -15,7 +15,9 @@
 namespace imd::firmware {
 namespace {
 
-uint32_t bits_of(float f) { return std::bit_cast<uint32_t>(f); }
+uint32_t bits_of(float f) {
+  return std::bit_cast<uint32_t>(f);
+}
 
 // NaNs compare by class: the cast keeps the payload's top bits and makes the NaN quiet, which
 // the conversion does as well; any NaN for a NaN is what the record needs.
@@ -28,26 +30,48 @@ void expect_same_float(float expected, float actual, uint64_t from) {
 }
 
 TEST(Binary64, WideningIsTheCastOnEveryKindOfFloat) {
-  const float cases[] = {0.0f, -0.0f, 1.0f, -1.0f, 0.1f, 14.0f, 0.4128f, 1e-30f,
-                         std::numeric_limits<float>::min(), std::numeric_limits<float>::max(),
-                         std::numeric_limits<float>::denorm_min(), 3e-41f, -5e-39f,
+  const float cases[] = {0.0f,
+                         -0.0f,
+                         1.0f,
+                         -1.0f,
+                         0.1f,
+                         14.0f,
+                         0.4128f,
+                         1e-30f,
+                         std::numeric_limits<float>::min(),
+                         std::numeric_limits<float>::max(),
+                         std::numeric_limits<float>::denorm_min(),
+                         3e-41f,
+                         -5e-39f,
                          std::numeric_limits<float>::infinity(),
                          -std::numeric_limits<float>::infinity()};
   for (const float f : cases) {
     EXPECT_EQ(std::bit_cast<uint64_t>(static_cast<double>(f)), binary64_bits(f)) << f;
   }
-  EXPECT_TRUE(std::isnan(std::bit_cast<double>(
-      binary64_bits(std::numeric_limits<float>::quiet_NaN()))));
+  EXPECT_TRUE(
+      std::isnan(std::bit_cast<double>(binary64_bits(std::numeric_limits<float>::quiet_NaN()))));
 }
 
 TEST(Binary64, NarrowingIsTheCastOnTheEdgesOfFloat) {
   const double flt_max = std::numeric_limits<float>::max();
   const double ulp_top = std::ldexp(1.0, 104);  // float's ulp at its largest binade
   const double least = std::numeric_limits<float>::denorm_min();
-  const double cases[] = {0.0, -0.0, 1.0, 0.1, 10.1, -0.377, 1e-300, 1e300, flt_max,
+  const double cases[] = {0.0,
+                          -0.0,
+                          1.0,
+                          0.1,
+                          10.1,
+                          -0.377,
+                          1e-300,
+                          1e300,
+                          flt_max,
                           flt_max + ulp_top / 2 - std::ldexp(1.0, 70),  // just below the tie
                           flt_max + ulp_top / 2,                        // the tie: overflow
-                          least, least / 2, least / 2 * (1 + 1e-15), least * 1.5, least * 2.5,
+                          least,
+                          least / 2,
+                          least / 2 * (1 + 1e-15),
+                          least * 1.5,
+                          least * 2.5,
                           std::numeric_limits<float>::min() * (1 - 1e-9),  // rounds up to normal
                           1 + std::ldexp(1.0, -24),                        // tie to even: 1
                           1 + 3 * std::ldexp(1.0, -24),                    // tie to even: up
@@ -58,8 +82,8 @@ TEST(Binary64, NarrowingIsTheCastOnTheEdgesOfFloat) {
     const uint64_t bits = std::bit_cast<uint64_t>(d);
     expect_same_float(static_cast<float>(d), float_from_binary64(bits), bits);
   }
-  EXPECT_TRUE(std::isnan(float_from_binary64(
-      std::bit_cast<uint64_t>(std::numeric_limits<double>::quiet_NaN()))));
+  EXPECT_TRUE(std::isnan(
+      float_from_binary64(std::bit_cast<uint64_t>(std::numeric_limits<double>::quiet_NaN()))));
 }
 
 // Random doubles over the whole exponent range (uniform bits) and over float's range and just

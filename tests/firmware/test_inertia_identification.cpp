@@ -120,7 +120,8 @@ TEST(InertiaIdentification, AShaftThatDoesNotTurnSkipsTheStep) {
   control::MotorParameters heavy = motor_named(c.motor);
   heavy.J_kgm2 *= 1000.0;
   const sim::SimBoardConfig b = rotating_board(c);
-  InertiaPlan ip = plan_inertia_test(c.nameplate, c.i_max_A, c.v_bus_V, b.period_s, Real(b.encoder_cpr));
+  InertiaPlan ip =
+      plan_inertia_test(c.nameplate, c.i_max_A, c.v_bus_V, b.period_s, Real(b.encoder_cpr));
   ip.max_accelerate_s = 2.0;
   Rig<double> rig(heavy, b, plan_identification(c.nameplate, c.i_max_A, c.v_bus_V, b.period_s), ip);
   run(rig);
@@ -135,9 +136,9 @@ TEST(InertiaIdentification, AShaftThatDoesNotTurnSkipsTheStep) {
 TEST(InertiaIdentification, AnEncoderCountingBackwardsIsNamed) {
   const Case& c = test_cases::kSmall;
   const sim::SimBoardConfig b = rotating_board(c);
-  Rig<float> rig(motor_named(c.motor), b,
-                 plan_identification(c.nameplate, c.i_max_A, c.v_bus_V, b.period_s),
-                 plan_inertia_test(c.nameplate, c.i_max_A, c.v_bus_V, b.period_s, Real(b.encoder_cpr)));
+  Rig<float> rig(
+      motor_named(c.motor), b, plan_identification(c.nameplate, c.i_max_A, c.v_bus_V, b.period_s),
+      plan_inertia_test(c.nameplate, c.i_max_A, c.v_bus_V, b.period_s, Real(b.encoder_cpr)));
   rig.encoder_sign = -1;
   run(rig);
   EXPECT_FALSE(rig.commissioning.succeeded());
@@ -154,9 +155,9 @@ TEST(InertiaIdentification, AnEncoderCountingBackwardsIsNamed) {
 TEST(InertiaIdentification, AShaftDrivenByItsLoadIsLeftWithThePwmOff) {
   const Case& c = test_cases::kSmall;
   const sim::SimBoardConfig b = rotating_board(c);
-  Rig<float> rig(motor_named(c.motor), b,
-                 plan_identification(c.nameplate, c.i_max_A, c.v_bus_V, b.period_s),
-                 plan_inertia_test(c.nameplate, c.i_max_A, c.v_bus_V, b.period_s, Real(b.encoder_cpr)));
+  Rig<float> rig(
+      motor_named(c.motor), b, plan_identification(c.nameplate, c.i_max_A, c.v_bus_V, b.period_s),
+      plan_inertia_test(c.nameplate, c.i_max_A, c.v_bus_V, b.period_s, Real(b.encoder_cpr)));
   while (!rig.commissioning.finished() && rig.commissioning.rotating() == nullptr) {
     rig.board.run_tick();  // the standstill steps, unloaded
   }
@@ -182,10 +183,9 @@ TEST(InertiaIdentification, AWrongPolePairCountStallsAndIsNamed) {
     c.nameplate.pole_pairs = 1;
     sim::SimBoardConfig b = rotating_board(c);
     b.seed = seed;
-    Rig<float> rig(motor_named(c.motor), b,
-                   plan_identification(c.nameplate, c.i_max_A, c.v_bus_V, b.period_s),
-                   plan_inertia_test(c.nameplate, c.i_max_A, c.v_bus_V, b.period_s,
-                                     Real(b.encoder_cpr)));
+    Rig<float> rig(
+        motor_named(c.motor), b, plan_identification(c.nameplate, c.i_max_A, c.v_bus_V, b.period_s),
+        plan_inertia_test(c.nameplate, c.i_max_A, c.v_bus_V, b.period_s, Real(b.encoder_cpr)));
     run(rig);
     EXPECT_FALSE(rig.commissioning.succeeded()) << "seed " << seed;
     EXPECT_EQ(rig.commissioning.failure_code(), 11) << "seed " << seed;  // stalled

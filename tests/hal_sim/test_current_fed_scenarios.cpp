@@ -7,10 +7,10 @@
 
 #include "control/current_fed_model.hpp"
 #include "firmware/drive_state.hpp"
+#include "float_design_skip.hpp"
+#include "hal_sim/drive/scenario_run.hpp"
 #include "hal_sim/scenario.hpp"
 #include "test_motors.hpp"
-#include "hal_sim/drive/scenario_run.hpp"
-#include "float_design_skip.hpp"
 
 namespace imd::sim {
 namespace {
@@ -20,7 +20,6 @@ Scenario scenario(const std::string& name, const std::vector<std::string>& overr
 }
 
 TEST(Seed001Paper, DecouplesExactlyAndSettlesTheFlux) {
-  IMD_SKIP_IF_FLOAT_DESIGN("the decoupling is exact to 1e-9 with double coefficients only");
   const Scenario s = scenario("seed001_paper.toml");
   std::vector<SimRow> boundaries;
   bool finite = true;
@@ -48,14 +47,18 @@ TEST(Seed001Paper, DecouplesExactlyAndSettlesTheFlux) {
     worst_y2 = std::max(worst_y2, std::abs(next.y2 - now.y2_ref) / std::abs(now.y2_ref));
   }
   std::printf("seed001 paper: worst relative error torque %.2e, y2 %.2e\n", worst_torque, worst_y2);
-  EXPECT_LE(worst_torque, 1e-9);
-  EXPECT_LE(worst_y2, 1e-9);
-  // The references reach the law at the right tick: v1 is the torque wanted at the next
-  // boundary, so the torque is 120 N m from the first boundary at or after 1 s, 0 before.
-  for (std::size_t k = 1; k < boundaries.size(); ++k) {
-    if (boundaries[k].t_s >= 1.0 && boundaries[k - 1].t_s < 1.0) {
-      EXPECT_NEAR(boundaries[k].torque_Nm, 120.0, 1e-9 * 120.0);
-      EXPECT_NEAR(boundaries[k - 1].torque_Nm, 0.0, 1e-9);
+  // Exact to double rounding with double coefficients; float's (the float-design build) put
+  // the plant and the law's model 1e-7 apart, which this exactness does not allow for.
+  if (kDoubleDesigns) {
+    EXPECT_LE(worst_torque, 1e-9);
+    EXPECT_LE(worst_y2, 1e-9);
+    // The references reach the law at the right tick: v1 is the torque wanted at the next
+    // boundary, so the torque is 120 N m from the first boundary at or after 1 s, 0 before.
+    for (std::size_t k = 1; k < boundaries.size(); ++k) {
+      if (boundaries[k].t_s >= 1.0 && boundaries[k - 1].t_s < 1.0) {
+        EXPECT_NEAR(boundaries[k].torque_Nm, 120.0, 1e-9 * 120.0);
+        EXPECT_NEAR(boundaries[k - 1].torque_Nm, 0.0, 1e-9);
+      }
     }
   }
 
@@ -101,7 +104,6 @@ TEST(Seed001Paper, MetricsAndStartUpAreRight) {
 }
 
 TEST(Seed001OuterLoop, FluxLoopRemovesTheSlipExcess) {
-  IMD_SKIP_IF_FLOAT_DESIGN("the torque error is at double rounding level (1e-9) only");
   // With the loop of Fig. 5 the squared stator flux sits on its target at the boundaries despite
   // the slip (the integrator takes up what (21) neglects); decoupling is unchanged.
   const Scenario s = scenario("seed001_outer_loop.toml");
@@ -115,11 +117,14 @@ TEST(Seed001OuterLoop, FluxLoopRemovesTheSlipExcess) {
   // The slip changes at 1 s and 1.6 s; the loop's double pole at 0.905 per period leaves
   // nothing measurable after 1.4 s: the excess of the open loop (2e-3) is gone to 1e-6.
   EXPECT_NEAR(boundaries.back().stator_flux2_Wb2, s.stator_flux2_Wb2, 1e-6);
-  EXPECT_LE(r.torque_rms_err_Nm, 1e-9 * 120.0);
-  // With one tick of latency the current source gets u(k) one tick early: decoupling holds.
+  // With one tick of latency the current source gets u(k) one tick early: decoupling holds,
+  // to double rounding with double coefficients (as above).
   const Summary late =
       run_scenario(scenario("seed001_outer_loop.toml", {"simulation.pwm_latency_ticks=1"}));
-  EXPECT_LE(late.torque_rms_err_Nm, 1e-9 * 120.0);
+  if (kDoubleDesigns) {
+    EXPECT_LE(r.torque_rms_err_Nm, 1e-9 * 120.0);
+    EXPECT_LE(late.torque_rms_err_Nm, 1e-9 * 120.0);
+  }
   // The loop inverts the magnitude relation of y2, so the start from 1 % of the flux does not
   // overshoot wildly (a linear v2 would reach 4 Wb^2, 400 %): measured 10.8 %.
   double peak = 0.0;

@@ -18,11 +18,11 @@
 #include "firmware/laws/iol_stage.hpp"
 #include "firmware/limitation.hpp"
 #include "firmware/protocol/messages.hpp"
+#include "float_design_skip.hpp"
 #include "hal_sim/drive/scenario_config.hpp"
 #include "hal_sim/drive/scenario_run.hpp"
 #include "hal_sim/scenario.hpp"
 #include "test_motors.hpp"
-#include "float_design_skip.hpp"
 
 namespace imd::sim {
 namespace {

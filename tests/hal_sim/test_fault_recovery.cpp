@@ -17,11 +17,11 @@
 
 #include "firmware/drive_state.hpp"
 #include "firmware/protection/stop_category.hpp"
+#include "float_design_skip.hpp"
 #include "hal_sim/drive/scenario_run.hpp"
 #include "hal_sim/law_variant.hpp"
 #include "hal_sim/scenario.hpp"
 #include "test_motors.hpp"
-#include "float_design_skip.hpp"
 
 namespace imd::sim {
 namespace {
@@ -102,7 +102,8 @@ class FaultMatrix : public testing::TestWithParam<std::tuple<std::string, std::s
 TEST_P(FaultMatrix, DetectsStopsClearsAndRunsAgainAsAfterPowerUp) {
   const auto& [law, precision, kind_index] = GetParam();
   if (precision == "double") {
-    IMD_SKIP_IF_FLOAT_DESIGN("the double tick runs on double designs; the MCU's float tick is the float case");
+    IMD_SKIP_IF_FLOAT_DESIGN(
+        "the double tick runs on double designs; the MCU's float tick is the float case");
   }
   const Kind& k = kKinds[kind_index];
   const Scenario s = matrix_case(law, precision, k);

@@ -6,10 +6,10 @@
 #include <vector>
 
 #include "control/voltage_fed_model.hpp"
+#include "float_design_skip.hpp"
+#include "hal_sim/drive/scenario_run.hpp"
 #include "hal_sim/scenario.hpp"
 #include "test_motors.hpp"
-#include "hal_sim/drive/scenario_run.hpp"
-#include "float_design_skip.hpp"
 
 namespace imd::sim {
 namespace {
@@ -32,7 +32,8 @@ TEST(Seed000Paper, TrueStateAndLoadGiveDeadbeatTracking) {
 }
 
 TEST(Seed000Paper, SectionIvObserversConverge) {
-  IMD_SKIP_IF_FLOAT_DESIGN("the observer equals the exact model to 1e-9 with double coefficients only");
+  IMD_SKIP_IF_FLOAT_DESIGN(
+      "the observer equals the exact model to 1e-9 with double coefficients only");
   // The paper's flux observer starts from zero; the drive holds the magnetizing current until
   // the estimate reaches 95 % of the reference, and ramps the speed reference (2000 rad/s^2) to
   // catch up with the sine afterwards.

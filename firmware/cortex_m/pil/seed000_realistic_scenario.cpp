@@ -4,8 +4,8 @@
 
 #include "hal_sim/drive/embedded_scenario.hpp"
 
-// The values are the file's, in double. The drive's parameters are in its design arithmetic
-// (float on the MCU: control/real.hpp), and each is rounded to it once, as it is assigned.
+// The values are the file's, in double; the drive's parameters are in its design
+// arithmetic (float on the MCU: control/real.hpp), each rounded once as assigned.
 #pragma GCC diagnostic ignored "-Wfloat-conversion"
 
 namespace imd::firmware {

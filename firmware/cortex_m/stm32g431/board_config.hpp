@@ -112,10 +112,11 @@ constexpr DriveConfig drive_config() {
   c.speed_reaching_pole = Real(0.98);
   c.flux_reaching_pole = Real(0.98);
   c.i_max_A = kCurrentLimit_A;
-  c.dead_time_s = Real(kDeadTime_ns * 1e-9);  // what TIM1's BDTR programs, compensated in the duties
+  c.dead_time_s =
+      Real(kDeadTime_ns * 1e-9);  // what TIM1's BDTR programs, compensated in the duties
   c.max_accel_rad_s2 = 200.0;  // set_speed steps from CAN are ramped
   c.encoder_observer_bandwidth_rad_s = 400.0;
-  c.adc_offset_limit_A = Real(0.02 * kCurrentRange_A);
+  c.adc_offset_limit_A = Real(0.02) * kCurrentRange_A;
   c.node_id = 1;
   c.commands_over_can = true;
   c.auto_enable = false;
@@ -126,8 +127,8 @@ constexpr DriveConfig drive_config() {
   c.fault_output_line = kLineFault;
   c.timing_output_line = kLineTiming;
   ProtectionConfig& p = c.protection;
-  p.overcurrent_A = 0.9 * kCurrentRange_A;  // 9 A: 1.5 x the limit, inside the range
-  p.bus_min_V = Real(0.7 * kBusNominal_V);        // 218 V while enabled
+  p.overcurrent_A = Real(0.9) * kCurrentRange_A;  // 9 A: 1.5 x the limit, inside the range
+  p.bus_min_V = Real(0.7) * kBusNominal_V;        // 218 V while enabled
   p.bus_max_V = 400.0;                      // margin below the 450 V capacitors
   p.overspeed_rad_s = 400.0;
   p.command_timeout_s = Real(0.2);
