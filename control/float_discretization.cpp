@@ -11,24 +11,12 @@
 
 namespace imd::control {
 
-namespace {
-
-/// Ls Lr - Lm^2 by Kahan's fused product difference: within 2 ulp of the value the float
-/// parameters give, however close Lm^2 is to Ls Lr (sigma is a few percent of Ls).
-float leakage_product_H2(float ls_H, float lr_H, float lm_H) noexcept {
-  const float lm2 = lm_H * lm_H;
-  const float lm2_error = std::fma(-lm_H, lm_H, lm2);  // lm2 - Lm^2, exactly
-  return std::fma(ls_H, lr_H, -lm2) + lm2_error;
-}
-
-}  // namespace
-
 VoltageFedFloatGenerators voltage_fed_float_generators(const MotorParameters& motor,
                                                        Real delta_s) noexcept {
   const float rs = float(motor.Rs_Ohm), ls = float(motor.Ls_H), lm = float(motor.Lm_H);
   const float rr = float(motor.Rr_Ohm), lr = float(motor.Lr_H), j = float(motor.J_kgm2);
   const float delta = float(delta_s);
-  const float sigma_lr = leakage_product_H2(ls, lr, lm);  // sigma Lr
+  const float sigma_lr = leakage_product_H2(ls, lr, lm);  // sigma_H Lr = Ls Lr - Lm^2 (motor_parameters.hpp)
   const float alpha = rr / lr;
   const float beta = lm / sigma_lr;
   const float inv_sigma = lr / sigma_lr;
