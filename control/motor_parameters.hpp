@@ -56,19 +56,14 @@ struct CurrentFedConstantsIn {
 };
 using CurrentFedConstants = CurrentFedConstantsIn<Real>;
 
-/// sigma Lr Ls = Ls Lr - Lm^2, the leakage product, in S. Lm^2 is within a few percent of Ls Lr,
-/// so the difference loses that factor's digits: in float it is Kahan's fused product
-/// difference, within 2 ulp of the value the parameters give; in double the plain one (its
-/// rounding, 1e-16 times Ls/sigma, is far below any use).
-template <typename S>
-S leakage_product_H2(S Ls_H, S Lr_H, S Lm_H) noexcept {
-  if constexpr (std::is_same_v<S, float>) {
-    const float lm2 = Lm_H * Lm_H;
-    const float lm2_error = std::fma(-Lm_H, Lm_H, lm2);  // lm2 - Lm^2, exactly
-    return std::fma(Ls_H, Lr_H, -lm2) + lm2_error;
-  } else {
-    return Ls_H * Lr_H - Lm_H * Lm_H;
-  }
+/// sigma Lr Ls = Ls Lr - Lm^2, the leakage product, in float. Lm^2 is within a few percent of
+/// Ls Lr, so the plain difference loses that factor's digits; Kahan's fused product difference
+/// is within 2 ulp of the value the parameters give. (In double the plain difference's rounding,
+/// 1e-16 times Ls / sigma, is far below any use: the derivations below keep it there.)
+inline float leakage_product_H2(float Ls_H, float Lr_H, float Lm_H) noexcept {
+  const float lm2 = Lm_H * Lm_H;
+  const float lm2_error = std::fma(-Lm_H, Lm_H, lm2);  // lm2 - Lm^2, exactly
+  return std::fma(Ls_H, Lr_H, -lm2) + lm2_error;
 }
 
 /// Paper 000 constants in S. Requires valid parameters (see find_invalid_parameter).
