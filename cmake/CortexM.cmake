@@ -1,7 +1,7 @@
 # Firmware images for Cortex-M4F targets.
 #
 # imd_add_cortex_m_image(NAME LINKER_SCRIPT script [TICK_ROOTS sym...] [NO_DOUBLE]
-#                        SOURCES src... LIBRARIES lib...)
+#                        [STACK_LEVELS handlers...] SOURCES src... LIBRARIES lib...)
 # links NAME.elf with the target's linker script and writes NAME.map, NAME.size.txt, and the
 # flashable NAME.bin (raw, from the first flash address) and NAME.hex (Intel HEX). The
 # link itself refuses exceptions: every throw entry point is wrapped (--wrap) and the wrappers
@@ -11,7 +11,15 @@
 # tools/check_tick_path.py then follows the static call graph from those interrupt entries and
 # fails the build if the tick can reach double-precision soft-float, the allocator (or its
 # traps) or exceptions; with NO_DOUBLE, also if double-precision soft-float is linked at all.
+# With STACK_LEVELS (the interrupt levels that preempt the main loop, lowest first, each a
+# comma-separated list of handlers), tools/check_stack.py bounds the stack from the compiler's
+# frames and the call graph, fails the build if the bound exceeds the linker script's
+# STACK_SIZE and writes the deepest paths to NAME.stack.txt.
 find_package(Python3 REQUIRED COMPONENTS Interpreter)
+
+# Each object's call graph with its functions' frames (NAME.ci beside the object), from which
+# tools/check_stack.py bounds the stack of an image (imd_add_cortex_m_image's STACK_CHECK).
+add_compile_options(-fcallgraph-info=su)
 
 set(IMD_NO_HEAP_NO_EXCEPTIONS_WRAPS
     malloc free calloc realloc memalign _malloc_r _free_r _calloc_r _realloc_r _memalign_r
@@ -22,7 +30,8 @@ find_program(IMD_ARM_SIZE arm-none-eabi-size REQUIRED)
 find_program(IMD_ARM_OBJCOPY arm-none-eabi-objcopy REQUIRED)
 
 function(imd_add_cortex_m_image NAME)
-  cmake_parse_arguments(ARG "NO_DOUBLE" "LINKER_SCRIPT" "TICK_ROOTS;SOURCES;LIBRARIES" ${ARGN})
+  cmake_parse_arguments(ARG "NO_DOUBLE" "LINKER_SCRIPT" "TICK_ROOTS;STACK_LEVELS;SOURCES;LIBRARIES"
+                        ${ARGN})
   add_executable(${NAME} ${ARG_SOURCES})
   set_target_properties(${NAME} PROPERTIES SUFFIX ".elf")
   target_link_libraries(${NAME} PRIVATE ${ARG_LIBRARIES} imd_hal_cortex_m imd_cortex_m_runtime)
@@ -63,6 +72,17 @@ function(imd_add_cortex_m_image NAME)
               --objdump ${CMAKE_OBJDUMP} $<TARGET_FILE:${NAME}> ${roots}
               --deny-regex "^__wrap_"
               --report $<TARGET_FILE_DIR:${NAME}>/${NAME}.tick_path.txt
+      VERBATIM)
+  endif()
+  if(ARG_STACK_LEVELS)
+    set(levels "")
+    foreach(level IN LISTS ARG_STACK_LEVELS)
+      list(APPEND levels --level ${level})
+    endforeach()
+    add_custom_command(TARGET ${NAME} POST_BUILD
+      COMMAND ${Python3_EXECUTABLE} ${PROJECT_SOURCE_DIR}/tools/check_stack.py
+              --objdump ${CMAKE_OBJDUMP} $<TARGET_FILE:${NAME}> --ci-dir ${PROJECT_BINARY_DIR}
+              ${levels} --report $<TARGET_FILE_DIR:${NAME}>/${NAME}.stack.txt
       VERBATIM)
   endif()
 endfunction()

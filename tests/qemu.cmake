@@ -70,6 +70,7 @@ add_test(NAME qemu_pil_mps2_an386
                  --elf ${CMAKE_BINARY_DIR}/qemu-cortex-m4f/bin/drive_pil_mps2_an386.elf
                  --drive-sim $<TARGET_FILE:drive_sim>
                  --scenario ${PROJECT_SOURCE_DIR}/hal_sim/scenarios/seed000_realistic.toml
+                 --stack-report ${CMAKE_BINARY_DIR}/qemu-cortex-m4f/bin/drive_pil_mps2_an386.stack.txt
                  --work ${CMAKE_BINARY_DIR}/qemu-work-pil)
 # Alone: the figures it prints are instruction counts, but one QEMU keeps a core busy.
 set_tests_properties(qemu_pil_mps2_an386 PROPERTIES LABELS qemu RUN_SERIAL ON TIMEOUT 900)

@@ -5,6 +5,7 @@ scenario (drive_sim, drive.precision=float).
 
 usage: pil_test.py --elf FILE --drive-sim FILE --scenario FILE --work DIR [--seeds N]
                    [--controller NAME] [--cycles-per-instruction C] [--max-tick-share S]
+                   [--stack-report FILE]
 
 The image runs the compiled-in scenario of the same name as FILE's stem; --controller changes
 its law (and the host's) to NAME.
@@ -26,10 +27,13 @@ its ticks) on the STM32G431's 170 MHz core at C cycles per instruction (default 
 --max-tick-share S the mean must be at most S of the period: S * period * 170 MHz / C
 instructions. The image's measurement of a float recompute of the exact discretization (its
 `pil recompute` line) must be present, take time, and fit inside the stack its probe paints;
-its cost is printed.
+its cost is printed. With --stack-report FILE (tools/check_stack.py's report on the image), the
+stack's high-water mark of the run must lie within the bound the build computed: a measured
+use above it would prove the bound wrong.
 """
 import argparse
 import json
+import re
 import statistics
 import subprocess
 import sys
@@ -87,6 +91,7 @@ def main():
     parser.add_argument("--controller", default="")
     parser.add_argument("--cycles-per-instruction", type=float, default=1.0)
     parser.add_argument("--max-tick-share", type=float, default=None)
+    parser.add_argument("--stack-report", type=Path, default=None)
     args = parser.parse_args()
     args.work.mkdir(parents=True, exist_ok=True)
 
@@ -157,6 +162,13 @@ def main():
           f"stack_bytes {pil.get('recompute.stack_bytes')}")
     print(f"pil_test: float recompute of the discretization: {recompute_ns} instructions, "
           f"{recompute_stack} B of stack, over {pil.get('recompute.runs')} runs")
+    if args.stack_report is not None:
+        first = args.stack_report.read_text().splitlines()[0]
+        bound = re.search(r": (\d+) B of \d+ B reserved$", first)
+        used = int(pil.get("memory.stack_used_bytes", "-1"))
+        check(bound is not None and 0 < used <= int(bound[1]),
+              "the stack's high-water mark within the build's bound",
+              f"{used} B used, bound {bound[1] if bound else '?'} B ({args.stack_report.name})")
     print(f"pil_test: {'passed' if failed == 0 else f'{failed} check(s) failed'}")
     return 0 if failed == 0 else 1
 
