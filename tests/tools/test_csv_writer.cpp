@@ -81,4 +81,22 @@ TEST(CsvWriter, FinishThenMoreRows) {
   EXPECT_EQ(text, reference);
 }
 
+// A write that fails (a full disk) makes finish() false, for every method: with the threaded
+// one the failure happens on the worker and must reach the caller.
+TEST(CsvWriter, AFullDiskIsReported) {
+  using imd::tools::CsvFormatting;
+  const std::vector<imd::sim::SimRow> input = rows(3000);
+  for (CsvFormatting formatting : {CsvFormatting::threaded, CsvFormatting::buffered,
+                                   CsvFormatting::buffered_to_chars, CsvFormatting::fmt_per_row}) {
+    std::FILE* file = std::fopen("/dev/full", "w");
+    ASSERT_NE(file, nullptr) << "no /dev/full";
+    imd::tools::CsvWriter writer(file, formatting);
+    writer.header();
+    for (const imd::sim::SimRow& r : input) writer.row(r);
+    EXPECT_FALSE(writer.finish()) << "method " << static_cast<int>(formatting);
+    EXPECT_FALSE(writer.finish()) << "a failure stays reported";
+    std::fclose(file);
+  }
+}
+
 }  // namespace

@@ -291,17 +291,15 @@ int main(int argc, char** argv) {
   };
   imd::sim::Summary summary;
   summary = imd::sim::run_scenario(scenario, callbacks);
-  bool written = !csv_writer || csv_writer->finish();
-  if (can_log != nullptr && (std::ferror(can_log) != 0 || std::fclose(can_log) != 0)) {
-    std::cerr << "\ndrive_sim: cannot write " << can_log_path << " (disk full?)\n";
-    return kExitOutputFailed;
-  }
-  if (csv != nullptr) written = std::ferror(csv) == 0 && std::fclose(csv) == 0 && written;
-  if (!written) {
-    std::cerr << "\ndrive_sim: cannot write " << csv_path << " (disk full?)\n";
-    return kExitOutputFailed;
-  }
-  if (summary.wall_time_s > 1.0) std::fprintf(stderr, "\n");
+  // A file that could not be written is reported, and the run's summary is still given: the
+  // simulation itself did not fail.
+  bool csv_written = !csv_writer || csv_writer->finish();
+  if (csv != nullptr) csv_written = std::ferror(csv) == 0 && std::fclose(csv) == 0 && csv_written;
+  const bool log_written =
+      can_log == nullptr || (std::ferror(can_log) == 0 && std::fclose(can_log) == 0);
+  if (summary.wall_time_s > 1.0 || !csv_written || !log_written) std::fprintf(stderr, "\n");
+  if (!log_written) std::cerr << "drive_sim: cannot write " << can_log_path << " (disk full?)\n";
+  if (!csv_written) std::cerr << "drive_sim: cannot write " << csv_path << " (disk full?)\n";
 
   const std::string text = imd::tools::summary_json(scenario, summary).dump(2);
   std::cout << text << '\n';
@@ -315,6 +313,10 @@ int main(int argc, char** argv) {
   if (scenario.commissioning) {
     const int status = report_commissioning(scenario, summary, motor_out_path, overrides);
     if (status != 0) return status;
+  }
+  if (!csv_written || !log_written) {  // and no plot of a partial CSV
+    if (temporary_csv) std::filesystem::remove(csv_path);
+    return kExitOutputFailed;
   }
   if (!plot_path.empty()) {
     std::string title = std::filesystem::path(scenario.source).filename().string();
