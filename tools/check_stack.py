@@ -116,13 +116,16 @@ def unqualified(dname):
 
 
 def scan(tool, elf):
-    """{function start: sum of the stack decrements in its code} for every function, and the
-    functions that call their own start (check_tick_path's graph leaves such calls out)."""
+    """{function start: sum of the stack decrements in its code} for every function (None when
+    it moves the stack pointer by a register: a dynamic frame), and the functions that call
+    their own start (check_tick_path's graph leaves such calls out)."""
     sums, current, recursive = {}, None, set()
     for line in ctp.objdump(tool, '-d', '--no-show-raw-insn', elf).splitlines():
         if m := re.match(r'^([0-9a-f]+) <', line):
             current = int(m[1], 16)
             sums.setdefault(current, 0)
+            continue
+        if sums.get(current, 0) is None:
             continue
         if (m := SELF_CALL_RE.match(line)) and current is not None and int(m[1], 16) == current:
             recursive.add(current)
@@ -138,6 +141,8 @@ def scan(tool, elf):
             sums[current] += 4 * regs * (2 if re.search(r'\bd\d', ops) else 1)
         elif mn in ('sub', 'subw') and (s := re.match(r'sp,\s*(?:sp,\s*)?#(\d+)', ops)):
             sums[current] += int(s[1])
+        elif mn == 'sub' and re.match(r'sp,\s*(?:sp,\s*)?(r\d+|ip|lr)', ops):
+            sums[current] = None
         elif mn == 'str' and (s := re.search(r'\[sp,\s*#-(\d+)\]!', ops)):
             sums[current] += int(s[1])
     return sums, recursive
@@ -173,6 +178,8 @@ def graph(args):
     for f in funcs.values():
         known = [frames[n] for n in f.names if n in frames]
         frame[f.start] = max(known) if known else fallback.get(f.start, 0)
+        if frame[f.start] is None:
+            raise Unbounded(f'{f.label()}: moves the stack pointer by a register (no .ci frame)')
         targets = {t for t, _ in f.edges} | ({f.start} & recursive)
         if f.indirect_sites:
             sites = max((indirect.get(n, []) for n in f.names), key=len)
