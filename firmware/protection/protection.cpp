@@ -161,7 +161,10 @@ inline void Protection<T>::check_driving(const Measurement<T>& m, const Estimate
   if (config_.check_adc_stuck && motor.adc_stuck.stuck(m.phase_code, u_last_V)) {
     trip.add(FaultCode::adc_stuck);
   }
-  if (e.current_predicted && !s.dc_braking) {
+  // Codes that repeat exactly (a stuck ADC, before its own check has the evidence to say so)
+  // read as a current that stopped following the model: not a phase's verdict to give.
+  const bool frozen = config_.check_adc_stuck && motor.adc_stuck.repeating();
+  if (e.current_predicted && !s.dc_braking && !frozen) {
     const control::PhaseValues<T> predicted = control::inverse_clarke(e.i_predicted_alphabeta_A);
     const T i_predicted_abc_A[3] = {predicted[0], predicted[1], predicted[2]};
     const int lost = motor.phase_loss.lost_phase(i_predicted_abc_A, m.i_abc_A, m.v_bus_V);

@@ -2,9 +2,12 @@
 // order the first is named, what is judged only while the inverter drives the motor.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
+#include "control/frames.hpp"
+#include "control/voltage_fed_model.hpp"
 #include "firmware/protection/protection.hpp"
 #include "paper_motor.hpp"
 
@@ -174,6 +177,49 @@ TEST(Protection, TheSensorChecksCanBeSwitchedOff) {
   b.config.protection.check_encoder = true;
   MotorProtection checked = b.make();
   EXPECT_EQ(checked.check(b.m, b.e, b.s, b.law, b.out, Vec2::Zero()).first, FaultCode::encoder);
+}
+
+// A converter that freezes: its codes repeat while the model predicts the current moving on.
+// The frozen reading also looks like phases that stopped carrying current. Here the codes
+// freeze as a phase-loss window opens, with phase a's current near zero, and the voltage holds
+// still for the stuck check's first window (no evidence: it restarts); the phase-loss window
+// would end first and blame phase a. It must wait while the codes repeat, so that the stuck
+// check names the fault once the voltage moves (50 V turning, in its second window).
+TEST(Protection, FrozenCodesAreAStuckAdcNotALostPhase) {
+  Bench b;
+  MotorProtection p = b.make();
+  const control::VoltageFedConstants k = control::derive_voltage_fed(test::paper_motor());
+  const int window = int(std::max(std::ceil(1 / (k.gamma_per_s * b.config.sample_period_s)), 4.0));
+  const int stuck_ticks = b.config.protection.adc_stuck_ticks;
+  ASSERT_GT(window, stuck_ticks) << "the case needs the phase-loss window to end in the freeze";
+  ASSERT_LT(window, 2 * stuck_ticks) << "and before the stuck check's second window ends";
+  const double amplitude_A = 3.0, step_rad = 0.1, pi = std::acos(-1.0);
+  const int freeze = window + 1;  // the first call is skipped: a window ends at the freeze
+  auto current = [&](int tick) {
+    const double angle = pi / 2 + step_rad * (tick - freeze + 1);  // phase a at zero then
+    return Vec2(amplitude_A * std::cos(angle), amplitude_A * std::sin(angle));
+  };
+  Trip first;
+  for (int tick = 0; tick < freeze + 2 * stuck_ticks && !first.any(); ++tick) {
+    const bool frozen = tick >= freeze;
+    b.e.current_predicted = true;
+    b.e.i_predicted_alphabeta_A = current(tick);  // the model runs on
+    if (!frozen) {
+      const control::PhaseValues<double> abc = control::inverse_clarke(current(tick));
+      for (int j = 0; j < 3; ++j) {
+        b.m.i_abc_A[j] = abc[j];
+        b.m.phase_code[std::size_t(j)] = uint16_t(2048 + std::lround(abc[j] / (10.0 / 2048)));
+      }
+    }
+    const double turn = tick < freeze + stuck_ticks ? 0.0 : 0.3 * (tick - freeze - stuck_ticks);
+    const Vec2 u_V(50.0 * std::cos(turn), 50.0 * std::sin(turn));
+    first = p.check(b.m, b.e, b.s, b.law, b.out, u_V);
+    if (!frozen) {
+      ASSERT_FALSE(first.any()) << "healthy tick " << tick;
+    }
+  }
+  ASSERT_TRUE(first.any()) << "the frozen converter went unnoticed";
+  EXPECT_EQ(first.first, FaultCode::adc_stuck);
 }
 
 }  // namespace
