@@ -189,7 +189,9 @@ TEST(Protection, FrozenCodesAreAStuckAdcNotALostPhase) {
   Bench b;
   MotorProtection p = b.make();
   const control::VoltageFedConstants k = control::derive_voltage_fed(test::paper_motor());
-  const int window = int(std::max(std::ceil(1 / (k.gamma_per_s * b.config.sample_period_s)), 4.0));
+  // The check's own rule (firmware/protection/protection.cpp), in the design arithmetic.
+  const int window =
+      int(std::max(std::ceil(Real(1) / (k.gamma_per_s * b.config.sample_period_s)), Real(4)));
   const int stuck_ticks = b.config.protection.adc_stuck_ticks;
   ASSERT_GT(window, stuck_ticks) << "the case needs the phase-loss window to end in the freeze";
   ASSERT_LT(window, 2 * stuck_ticks) << "and before the stuck check's second window ends";
