@@ -26,7 +26,7 @@ class AdcStuckCheck {
   void reset() noexcept {
     same_ticks_ = 0;
     started_ = false;
-    repeated_ = false;
+    repeated_run_ = 0;
   }
 
   /// `u_V`: the stator voltage applied over the last period (alpha-beta). True if stuck.
@@ -36,7 +36,7 @@ class AdcStuckCheck {
                           codes[2] == last_codes_[2];
     started_ = true;
     last_codes_ = codes;
-    repeated_ = repeated;
+    repeated_run_ = repeated ? repeated_run_ + (repeated_run_ < stuck_ticks_ ? 1 : 0) : 0;
     if (repeated) {
       ++same_ticks_;
       departure_sum_V_ += u_V - u_first_V_;
@@ -49,17 +49,19 @@ class AdcStuckCheck {
     return false;
   }
 
-  /// Whether the last tick's codes repeated the tick's before: a frozen measurement says nothing
-  /// of the current, and the checks that compare the current with the model wait
-  /// (docs/safety.md, "Phase loss").
-  bool repeating() const noexcept { return repeated_; }
+  /// Whether the checks that compare the current with the model should wait: the codes
+  /// repeat, and for less than one window. A frozen measurement says nothing of the current,
+  /// and this check names a stuck converter within its window if the voltage moved. Codes
+  /// that stay frozen longer under a still voltage (no evidence here) may as well be a quiet
+  /// converter on an open phase: they are judged again (docs/safety.md, "Phase loss").
+  bool deferring() const noexcept { return repeated_run_ > 0 && repeated_run_ < stuck_ticks_; }
 
   /// Takes over the state of the object this one replaces (the same motor but for its
   /// rotor resistance): the tick changes coefficients and keeps state (docs/robustness.md).
   void continue_from(const AdcStuckCheck& old) noexcept {
     same_ticks_ = old.same_ticks_;
     started_ = old.started_;
-    repeated_ = old.repeated_;
+    repeated_run_ = old.repeated_run_;
     last_codes_ = old.last_codes_;
     u_first_V_ = old.u_first_V_;
     departure_sum_V_ = old.departure_sum_V_;
@@ -70,7 +72,7 @@ class AdcStuckCheck {
   T A_per_V_, evidence_needed_A_;
   int same_ticks_ = 0;
   bool started_ = false;
-  bool repeated_ = false;  ///< the last codes equalled the ones before
+  int repeated_run_ = 0;  ///< ticks the codes have repeated in a row, up to stuck_ticks_
   std::array<uint16_t, 3> last_codes_{};
   control::Vec2<T> u_first_V_ = control::Vec2<T>::Zero();
   control::Vec2<T> departure_sum_V_ = control::Vec2<T>::Zero();

@@ -162,8 +162,10 @@ inline void Protection<T>::check_driving(const Measurement<T>& m, const Estimate
     trip.add(FaultCode::adc_stuck);
   }
   // Codes that repeat exactly (a stuck ADC, before its own check has the evidence to say so)
-  // read as a current that stopped following the model: not a phase's verdict to give.
-  const bool frozen = config_.check_adc_stuck && motor.adc_stuck.repeating();
+  // read as a current that stopped following the model: not a phase's verdict to give, for
+  // one stuck-ADC window at most (an open phase under a still voltage and a quiet ADC freezes
+  // the codes too, and must still be found).
+  const bool frozen = config_.check_adc_stuck && motor.adc_stuck.deferring();
   if (e.current_predicted && !s.dc_braking && !frozen) {
     const control::PhaseValues<T> predicted = control::inverse_clarke(e.i_predicted_alphabeta_A);
     const T i_predicted_abc_A[3] = {predicted[0], predicted[1], predicted[2]};

@@ -224,5 +224,33 @@ TEST(Protection, FrozenCodesAreAStuckAdcNotALostPhase) {
   EXPECT_EQ(first.first, FaultCode::adc_stuck);
 }
 
+// The other side of the wait: an open phase at standstill under a held voltage, read by a
+// quiet ADC, freezes the codes too, and gives the stuck check no evidence (a still voltage).
+// The phase-loss check waits one stuck-ADC window at most, then judges the frozen ticks: the
+// open phase is found within that window, the phase-loss window and the first skipped tick.
+TEST(Protection, AnOpenPhaseUnderAStillVoltageIsFoundThoughTheCodesRepeat) {
+  Bench b;
+  MotorProtection p = b.make();
+  const control::VoltageFedConstants k = control::derive_voltage_fed(test::paper_motor());
+  const int window_ticks =
+      int(std::max(std::ceil(Real(1) / (k.gamma_per_s * b.config.sample_period_s)), Real(4)));
+  const int stuck_ticks = b.config.protection.adc_stuck_ticks;
+  b.e.current_predicted = true;
+  b.e.i_predicted_alphabeta_A = Vec2(3.0, 0.0);  // the model: 3 A in phase a, -1.5 A in b, c
+  b.m.i_abc_A[0] = 0.0, b.m.i_abc_A[1] = 2.6, b.m.i_abc_A[2] = -2.6;  // a open: b to c only
+  b.m.phase_code = {2048, uint16_t(2048 + 532), uint16_t(2048 - 532)};  // 10 A / 2048 codes
+  b.m.i_peak_A = 2.6;
+  const Vec2 u_V(150.0, 0.0);  // saturated and held
+  Trip first;
+  int tick = 0;
+  for (; tick < 10 * (stuck_ticks + window_ticks) && !first.any(); ++tick) {
+    first = p.check(b.m, b.e, b.s, b.law, b.out, u_V);
+  }
+  ASSERT_TRUE(first.any()) << "the open phase went unnoticed for " << tick << " ticks";
+  EXPECT_EQ(first.first, FaultCode::phase_loss);
+  EXPECT_EQ(first.detail, 0) << "phase a";
+  EXPECT_LE(tick, stuck_ticks + window_ticks + 1);
+}
+
 }  // namespace
 }  // namespace imd::firmware
