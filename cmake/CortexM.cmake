@@ -17,9 +17,10 @@
 # STACK_SIZE and writes the deepest paths to NAME.stack.txt.
 find_package(Python3 REQUIRED COMPONENTS Interpreter)
 
-# Each object's call graph with its functions' frames (NAME.ci beside the object), from which
-# tools/check_stack.py bounds the stack of an image (imd_add_cortex_m_image's STACK_CHECK).
-add_compile_options(-fcallgraph-info=su)
+# Each object's call graph with its functions' frames (NAME.ci beside the object) and its
+# final GIMPLE (NAME.*.optimized: which indirect calls are virtual), from which
+# tools/check_stack.py bounds the stack of an image (imd_add_cortex_m_image's STACK_LEVELS).
+add_compile_options(-fcallgraph-info=su -fdump-tree-optimized)
 
 set(IMD_NO_HEAP_NO_EXCEPTIONS_WRAPS
     malloc free calloc realloc memalign _malloc_r _free_r _calloc_r _realloc_r _memalign_r
@@ -81,7 +82,8 @@ function(imd_add_cortex_m_image NAME)
     endforeach()
     add_custom_command(TARGET ${NAME} POST_BUILD
       COMMAND ${Python3_EXECUTABLE} ${PROJECT_SOURCE_DIR}/tools/check_stack.py
-              --objdump ${CMAKE_OBJDUMP} $<TARGET_FILE:${NAME}> --ci-dir ${PROJECT_BINARY_DIR}
+              --objdump ${CMAKE_OBJDUMP} $<TARGET_FILE:${NAME}>
+              --map $<TARGET_FILE_DIR:${NAME}>/${NAME}.map --build-dir ${PROJECT_BINARY_DIR}
               ${levels} --report $<TARGET_FILE_DIR:${NAME}>/${NAME}.stack.txt
       VERBATIM)
   endif()

@@ -6,24 +6,27 @@ The bound is the deepest path of the main thread (from the reset handler) plus, 
 interrupt level that may preempt it, the deepest path of that level's handlers and the frame
 the core stacks on entry with the FPU context (26 words and an alignment word: 108 B). The
 levels are given as groups of handlers (--level, repeatable): handlers of one group cannot
-preempt each other, a group may preempt the ones before it. Faults and NMI (--faults) come
-last, one of them at a time.
+preempt each other, a group may preempt the ones before it. Then one fault handler (--faults)
+and NMI on top of it. The levels must name every interrupt the image enables: the check does
+not read the interrupt controller's set-up.
 
-Frames are the compiler's own (GCC's -fcallgraph-info=su, the NAME.ci files beside the objects,
---ci-dir): the bytes each function's frame takes, pushed registers included. Functions without
-one (libgcc, newlib, assembly) take the sum of every stack decrement in their code (`push`,
-`vpush`, `stmdb sp!`, `sub sp`, `str .., [sp, #-N]!`): at least their frame. A frame the compiler
-calls dynamic fails the check.
+The objects are those the image's link map names (--map, its paths relative to --build-dir).
+Frames are the compiler's own: GCC's -fcallgraph-info=su writes each object's functions'
+frames, pushed registers included, beside it (NAME.ci). Functions without one (libgcc, newlib,
+assembly) take the sum of every stack decrement in their code (`push`, `vpush`, `stmdb sp!`,
+`sub sp`, `str`/`strd .., [sp, #-N]!`): at least their frame. A frame the compiler calls
+dynamic, or a library function that moves the stack pointer by a register, fails the check.
 
 Calls come from the linked image, as tools/check_tick_path.py finds them (direct calls, tail
-calls, code falling into the next function). An indirect call is resolved by the name of the
-function it calls: the .ci file gives each indirect call's source location, whose text names the
-member called (`x.name(`, `p->name(`). A virtual call can reach only overriders of that name, so
-its targets are the address-taken functions of that name, when some virtual function (one in a
-vtable) has it. Otherwise (a function pointer, a call the text does not name, a function with
-more indirect calls in its code than the .ci file lists, or one without a .ci file) it may reach
-every address-taken function. A cycle (recursion) has no bound and fails the check.
-Limits: a function pointer whose name equals a virtual function's is taken for that function.
+calls, code falling into the next function). Indirect calls are resolved by the name of the
+member they call, where the compiler shows that a function's indirect calls are all virtual:
+its GIMPLE dump (-fdump-tree-optimized, beside the object) has no call through a pointer. The
+.ci file gives each indirect call's source place; the statement there names the member, and a
+virtual call reaches only the overriders of that name: the address-taken functions of that
+name, when some virtual function (one in a vtable) has it. Otherwise (a call through a
+pointer in the function, a statement naming no virtual function, a function with more
+indirect calls in its code than the .ci file lists, one without a .ci file or a dump) an
+indirect call may reach every address-taken function. A cycle (recursion) fails the check.
 """
 import argparse
 import functools
@@ -42,32 +45,73 @@ EDGE_RE = re.compile(r'^edge: \{ sourcename: "(?:[^"]*:)?([^":]+)" targetname: "
                      r' label: "(.*):(\d+):(\d+)" \}$')
 FRAME_RE = re.compile(r'\\n(\d+) bytes \(([a-z,]+)\)$')
 SELF_CALL_RE = re.compile(r'^\s*[0-9a-f]+:\s+blx?(?:\.w)?\s+([0-9a-f]+) <')
-DECREMENT_RE = re.compile(r'^\s*[0-9a-f]+:\s+(push|stmdb|vpush|sub|subw|str)(?:\.w)?\s+(.*)$')
+# GIMPLE: a function's header, and a call whose callee is an SSA name (`_5 (x_2);`,
+# `y_3 = fp.0_1 (x_2);`): a call through a pointer (builtins, `__atomic_load_1`, are not).
+# A virtual call reads OBJ_TYPE_REF (...).
+DUMP_FUNCTION_RE = re.compile(r'^;; Function .* \((\S+), funcdef_no=')
+POINTER_CALL_RE = re.compile(r'^\s+(?:[^=;]+ = )?(?!__)[A-Za-z_.][\w.]*_\d+(?:\(D\))? \(')
+DECREMENT_RE = re.compile(r'^\s*[0-9a-f]+:\s+(push|stmdb|vpush|sub|subw|str|strd)(?:\.w)?\s+(.*)$')
 
 
 class Unbounded(Exception):
     pass
 
 
-def read_ci(ci_dir):
-    """{mangled name: frame bytes}, {mangled name: [(file, line, col)]} from every .ci file
-    (a name compiled in several objects: its largest frame, and the calls of every copy)."""
-    frames, indirect = {}, {}
-    files = glob.glob(os.path.join(ci_dir, '**', '*.ci'), recursive=True)
-    if not files:
-        raise ctp.BadInput(f'no .ci files under {ci_dir} (built without -fcallgraph-info=su?)')
-    for path in files:
-        with open(path, errors='replace') as f:
+def linked_objects(map_path, build_dir):
+    """The objects the image's link map names (direct objects and the archive members it
+    took), as paths without their .obj/.o suffix: where their .ci and GIMPLE dumps are."""
+    try:
+        text = open(map_path, errors='replace').read()
+    except OSError as e:
+        raise ctp.BadInput(f'cannot read the link map {map_path}: {e.strerror}')
+    stems = set()
+    for path in re.findall(r'^LOAD (\S+\.(?:obj|o))$', text, re.M):
+        stems.add(os.path.join(build_dir, re.sub(r'\.(obj|o)$', '', path)))
+    for archive, member in set(re.findall(r'(\S+\.a)\(([^)\s]+\.(?:obj|o))\)', text)):
+        # CMake keeps a library's objects in <dir>/CMakeFiles/<name>.dir/..., by source path.
+        lib = os.path.basename(archive)[3:-2] if os.path.basename(archive).startswith('lib') else ''
+        objects = os.path.join(build_dir, os.path.dirname(archive), 'CMakeFiles', f'{lib}.dir')
+        for obj in glob.glob(os.path.join(objects, '**', member), recursive=True):
+            stems.add(re.sub(r'\.(obj|o)$', '', obj))
+    return sorted(stems)
+
+
+def read_objects(stems):
+    """From each object's .ci file: {mangled name: frame bytes}, {mangled name: [(file, line,
+    col)]} (a name compiled in several objects, as an inline function is: its largest frame,
+    and the longest list of calls). From its GIMPLE dump (-fdump-tree-optimized): the functions
+    that call through a pointer (an SSA name), not through a vtable (OBJ_TYPE_REF), and those
+    the dumps show."""
+    frames, indirect, pointer_callers, dumped = {}, {}, set(), set()
+    found = [stem for stem in stems if os.path.exists(stem + '.ci')]
+    if not found:
+        raise ctp.BadInput('no .ci file beside the linked objects (built without '
+                           '-fcallgraph-info=su?)')
+    for stem in found:
+        calls = {}  # this object's: one entry per call, an inlined body's calls once per copy
+        with open(stem + '.ci', errors='replace') as f:
             for line in f:
                 if m := NODE_RE.match(line):
                     if frame := FRAME_RE.search(m[2]):
                         if frame[2] != 'static':
                             raise Unbounded(f'{m[2].split(chr(92))[0]}: {frame[2]} frame '
-                                            f'({path})')
+                                            f'({stem}.ci)')
                         frames[m[1]] = max(frames.get(m[1], 0), int(frame[1]))
-                elif m := EDGE_RE.match(line):  # a name in several objects: all their calls
-                    indirect.setdefault(m[1], []).append((m[2], int(m[3]), int(m[4])))
-    return frames, indirect
+                elif m := EDGE_RE.match(line):
+                    calls.setdefault(m[1], []).append((m[2], int(m[3]), int(m[4])))
+        for name, sites in calls.items():  # an inline function's copies: the same calls
+            if len(sites) > len(indirect.get(name, [])):
+                indirect[name] = sites
+        for dump in glob.glob(glob.escape(stem) + '.*t.optimized'):
+            function = None
+            with open(dump, errors='replace') as f:
+                for line in f:
+                    if m := DUMP_FUNCTION_RE.match(line):
+                        function = m[1]
+                        dumped.add(function)
+                    elif function and POINTER_CALL_RE.match(line):
+                        pointer_callers.add(function)
+    return frames, indirect, pointer_callers, dumped
 
 
 @functools.lru_cache(maxsize=None)
@@ -143,14 +187,15 @@ def scan(tool, elf):
             sums[current] += int(s[1])
         elif mn == 'sub' and re.match(r'sp,\s*(?:sp,\s*)?(r\d+|ip|lr)', ops):
             sums[current] = None
-        elif mn == 'str' and (s := re.search(r'\[sp,\s*#-(\d+)\]!', ops)):
+        elif mn in ('str', 'strd') and (s := re.search(r'\[sp,\s*#-(\d+)\]!', ops)):
             sums[current] += int(s[1])
     return sums, recursive
 
 
 def graph(args):
     funcs, taken = ctp.build(args)
-    frames, indirect = read_ci(args.ci_dir)
+    frames, indirect, pointer_callers, dumped = read_objects(
+        linked_objects(args.map, args.build_dir))
     fallback, recursive = scan(args.objdump, args.elf)
     sections, symbols, _ = ctp.load(args.objdump, args.elf)
 
@@ -184,9 +229,13 @@ def graph(args):
         if f.indirect_sites:
             sites = max((indirect.get(n, []) for n in f.names), key=len)
             named = [called_names(s) & virtual_names for s in sites]
+            # By name only where the compiler's own view shows every indirect call of the
+            # function to be virtual: a dump of it, and no call through a pointer in it.
+            only_virtual = any(n in dumped for n in f.names) and not any(
+                n in pointer_callers for n in f.names)
             if f.start in startup_callers:
                 targets |= startup
-            elif len(sites) >= len(f.indirect_sites) and all(named):
+            elif only_virtual and len(sites) >= len(f.indirect_sites) and all(named):
                 for names in named:
                     for n in names:
                         targets |= by_name[n]
@@ -223,14 +272,17 @@ def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__,
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument('elf')
-    ap.add_argument('--ci-dir', required=True, help='directory searched for the .ci files')
+    ap.add_argument('--map', required=True, help="the image's link map (-Wl,-Map)")
+    ap.add_argument('--build-dir', required=True,
+                    help="the directory the link ran in (the map's relative paths start there)")
     ap.add_argument('--main', default='Reset_Handler', help='the main thread\'s entry')
     ap.add_argument('--level', action='append', default=[], metavar='H1,H2',
                     help='handlers of one interrupt level, lowest level first (repeatable)')
     ap.add_argument('--startup-caller', default='Reset_Handler',
                     help='the function whose indirect calls run the start-up arrays')
-    ap.add_argument('--faults', default='NMI_Handler,HardFault_Handler,MemManage_Handler,'
+    ap.add_argument('--faults', default='HardFault_Handler,MemManage_Handler,'
                     'BusFault_Handler,UsageFault_Handler,Default_Handler')
+    ap.add_argument('--nmi', default='NMI_Handler', help='preempts the faults too')
     ap.add_argument('--report', metavar='FILE', help='write each deepest path with its frames')
     ap.add_argument('--objdump', default='arm-none-eabi-objdump')
     imd_version.add_argument(ap)
@@ -254,8 +306,9 @@ def main(argv=None):
         parts = [('main thread', [root(args.main)], 0)]
         parts += [(f'level {i + 1}', [root(h) for h in lvl.split(',')], EXCEPTION_FRAME_BYTES)
                   for i, lvl in enumerate(args.level)]
-        faults = [root(h, required=False) for h in args.faults.split(',')]  # those linked
-        parts.append(('faults', [f for f in faults if f is not None], EXCEPTION_FRAME_BYTES))
+        for label, handlers in (('faults', args.faults), ('NMI', args.nmi)):
+            linked = [root(h, required=False) for h in handlers.split(',')]
+            parts.append((label, [f for f in linked if f is not None], EXCEPTION_FRAME_BYTES))
         rows, total = [], 0
         for label, starts, entry in parts:
             depth, chain = max((deepest(funcs, frame, callees, s) for s in starts),

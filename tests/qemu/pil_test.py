@@ -165,10 +165,10 @@ def main():
     if args.stack_report is not None:
         first = args.stack_report.read_text().splitlines()[0]
         bound = re.search(r": (\d+) B of \d+ B reserved$", first)
-        used = int(pil.get("memory.stack_used_bytes", "-1"))
-        check(bound is not None and 0 < used <= int(bound[1]),
-              "the stack's high-water mark within the build's bound",
-              f"{used} B used, bound {bound[1] if bound else '?'} B ({args.stack_report.name})")
+        bound_bytes = int(bound[1]) if bound else -1
+        used_bytes = int(pil.get("memory.stack_used_bytes", "-1"))
+        check(0 < used_bytes <= bound_bytes, "the stack's high-water mark within the build's bound",
+              f"{used_bytes} B used, bound {bound_bytes} B ({args.stack_report.name})")
     print(f"pil_test: {'passed' if failed == 0 else f'{failed} check(s) failed'}")
     return 0 if failed == 0 else 1
 

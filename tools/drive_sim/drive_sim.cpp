@@ -254,6 +254,14 @@ int main(int argc, char** argv) {
     csv_path =
         (std::filesystem::temp_directory_path() / fmt::format("drive_sim_{}.csv", ::getpid()))
             .string();
+  // Removed when main returns, whichever way.
+  struct RemovedAtExit {
+    std::string path;
+    ~RemovedAtExit() {
+      std::error_code ignored;
+      if (!path.empty()) std::filesystem::remove(path, ignored);
+    }
+  } const temporary{temporary_csv ? csv_path : std::string()};
   std::FILE* csv = nullptr;
   std::optional<imd::tools::CsvWriter> csv_writer;
   if (!csv_path.empty()) {
@@ -314,22 +322,17 @@ int main(int argc, char** argv) {
     const int status = report_commissioning(scenario, summary, motor_out_path, overrides);
     if (status != 0) return status;
   }
-  if (!csv_written || !log_written) {  // and no plot of a partial CSV
-    if (temporary_csv) std::filesystem::remove(csv_path);
-    return kExitOutputFailed;
-  }
-  if (!plot_path.empty()) {
+  if (!plot_path.empty() && csv_written) {  // no plot of a partial CSV
     std::string title = std::filesystem::path(scenario.source).filename().string();
     for (const std::string& o : overrides) title += " --set " + o;
     const int status = run_program({"/usr/bin/python3", plot_script(scenario), csv_path, "--out",
                                     plot_path, "--settle-s", fmt::format("{}", scenario.settle_s),
                                     "--title", title});
-    if (temporary_csv) std::filesystem::remove(csv_path);
     if (status != 0) {
       std::cerr << "drive_sim: plotting failed (" << plot_script(scenario) << ", status " << status
                 << "; it needs python3-matplotlib)\n";
       return kExitOutputFailed;
     }
   }
-  return 0;
+  return csv_written && log_written ? 0 : kExitOutputFailed;
 }
