@@ -179,6 +179,13 @@ TEST(Protection, TheSensorChecksCanBeSwitchedOff) {
   EXPECT_EQ(checked.check(b.m, b.e, b.s, b.law, b.out, Vec2::Zero()).first, FaultCode::encoder);
 }
 
+/// The phase-loss check's window on the paper motor: the check's own rule
+/// (firmware/protection/protection.cpp), in the design arithmetic.
+int phase_loss_window_ticks(const DriveConfig& config) {
+  const control::VoltageFedConstants k = control::derive_voltage_fed(test::paper_motor());
+  return int(std::max(std::ceil(Real(1) / (k.gamma_per_s * config.sample_period_s)), Real(4)));
+}
+
 // A converter that freezes: its codes repeat while the model predicts the current moving on.
 // The frozen reading also looks like phases that stopped carrying current. Here the codes
 // freeze as a phase-loss window opens, with phase a's current near zero, and the voltage holds
@@ -188,10 +195,7 @@ TEST(Protection, TheSensorChecksCanBeSwitchedOff) {
 TEST(Protection, FrozenCodesAreAStuckAdcNotALostPhase) {
   Bench b;
   MotorProtection p = b.make();
-  const control::VoltageFedConstants k = control::derive_voltage_fed(test::paper_motor());
-  // The check's own rule (firmware/protection/protection.cpp), in the design arithmetic.
-  const int window =
-      int(std::max(std::ceil(Real(1) / (k.gamma_per_s * b.config.sample_period_s)), Real(4)));
+  const int window = phase_loss_window_ticks(b.config);
   const int stuck_ticks = b.config.protection.adc_stuck_ticks;
   ASSERT_GT(window, stuck_ticks) << "the case needs the phase-loss window to end in the freeze";
   ASSERT_LT(window, 2 * stuck_ticks) << "and before the stuck check's second window ends";
@@ -231,9 +235,7 @@ TEST(Protection, FrozenCodesAreAStuckAdcNotALostPhase) {
 TEST(Protection, AnOpenPhaseUnderAStillVoltageIsFoundThoughTheCodesRepeat) {
   Bench b;
   MotorProtection p = b.make();
-  const control::VoltageFedConstants k = control::derive_voltage_fed(test::paper_motor());
-  const int window_ticks =
-      int(std::max(std::ceil(Real(1) / (k.gamma_per_s * b.config.sample_period_s)), Real(4)));
+  const int window_ticks = phase_loss_window_ticks(b.config);
   const int stuck_ticks = b.config.protection.adc_stuck_ticks;
   b.e.current_predicted = true;
   b.e.i_predicted_alphabeta_A = Vec2(3.0, 0.0);  // the model: 3 A in phase a, -1.5 A in b, c
