@@ -13,16 +13,11 @@
 #include "hal_sim/drive/scenario_run.hpp"
 #include "hal_sim/law_variant.hpp"
 #include "hal_sim/scenario.hpp"
+#include "fault_events_text.hpp"
 #include "test_motors.hpp"
 
 namespace imd::sim {
 namespace {
-
-std::string faults_text(const Summary& r) {
-  std::string text;
-  for (const FaultEvent& f : r.faults) text += f.code + " at " + std::to_string(f.detected_at_s) + " ";
-  return text;
-}
 
 TEST(AdcStuckSweep, AStuckAdcIsLatchedAsAdcStuckAtAnyTimeWithEveryLaw) {
   // The bound: the stuck-ADC check judges windows of 2 ms that never accumulate, and needs the

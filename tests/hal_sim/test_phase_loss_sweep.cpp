@@ -13,18 +13,13 @@
 #include "hal_sim/drive/scenario_run.hpp"
 #include "hal_sim/law_variant.hpp"
 #include "hal_sim/scenario.hpp"
+#include "fault_events_text.hpp"
 #include "test_motors.hpp"
 
 namespace imd::sim {
 namespace {
 
 const char* kLaws[] = {"dsmc", "ifoc", "iol"};
-
-std::string faults_text(const Summary& r) {
-  std::string text;
-  for (const FaultEvent& f : r.faults) text += f.code + " at " + std::to_string(f.detected_at_s) + " ";
-  return text;
-}
 
 TEST(PhaseLossSweep, AnOpenPhaseIsFoundAtAnyTimeWithEveryLaw) {
   // The profile's sine passes 100 rad/s, standstill and -100 rad/s with the load switching
