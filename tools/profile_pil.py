@@ -1,0 +1,136 @@
+#!/usr/bin/env python3
+"""Instructions per tick, by function, of the processor-in-the-loop image on QEMU.
+
+The PIL image (drive_pil_mps2_an386.elf) runs a scenario twice under `-icount shift=0`: once to
+--from-ms and once to --to-ms. QEMU's `-d in_asm,exec,nochain` log names every translated
+block's instructions once and every execution of a block with its function; the difference of
+the two runs' counts, per function, is what the ticks between the two times executed (the
+start-up and the model build cancel). The simulated plant and board of the PIL image are in
+the list too: on the board those are the motor and the peripherals' registers.
+
+  tools/profile_pil.py build-cortex-m4f/bin/drive_pil_mps2_an386.elf --from-ms 300 --to-ms 400
+
+The logs are parsed as they stream (a 100 ms window logs gigabytes), the two runs in parallel.
+"""
+import argparse
+import collections
+import concurrent.futures
+import os
+import re
+import subprocess
+import sys
+import tempfile
+
+_TRACE = re.compile(rb"^\[[0-9a-f]+/([0-9a-f]+)/[0-9a-f]+/[0-9a-f]+\] ?(.*)$")
+_INSN = re.compile(rb"^0x([0-9a-f]+):  ")
+
+
+def run_counts(elf, scenario, controller, duration_ms, lines_of=None):
+    """Instructions executed per function over a run of duration_ms."""
+    args = ["arg=pil", f"arg=scenario={scenario}", f"arg=duration_ms={duration_ms}"]
+    if controller:
+        args.append(f"arg=controller={controller}")
+    with tempfile.TemporaryDirectory() as tmp:
+        fifo = os.path.join(tmp, "log")
+        os.mkfifo(fifo)
+        qemu = subprocess.Popen(
+            ["qemu-system-arm", "-M", "mps2-an386", "-cpu", "cortex-m4", "-display", "none",
+             "-monitor", "none", "-serial", "stdio",
+             "-semihosting-config", "enable=on,target=native," + ",".join(args),
+             "-icount", "shift=0,sleep=off", "-d", "in_asm,exec,nochain", "-D", fifo,
+             "-kernel", elf], stdout=subprocess.PIPE, stderr=subprocess.STDOUT)
+        blocks = {}  # a block's start address -> its instructions' addresses (last translation)
+        executed = collections.Counter()  # a Trace line's "[.../pc/...] function" -> executions
+        with open(fifo, "rb", buffering=1 << 20) as log:
+            start = None
+            for line in log:
+                if line.startswith(b"Trace "):
+                    executed[line[line.find(b"["):]] += 1  # parsed once per block below
+                elif line.startswith(b"IN:"):
+                    start = None
+                elif line.startswith(b"0x"):
+                    m = _INSN.match(line)
+                    if m is None:
+                        continue
+                    pc = int(m.group(1), 16)
+                    if start is None:
+                        start = pc
+                        blocks[start] = []
+                    blocks[start].append(pc)
+                else:
+                    start = None
+        out, _ = qemu.communicate()
+        if b"pil end status" not in out or b"pil fault code none" not in out:
+            sys.exit(f"profile_pil: the run to {duration_ms} ms failed:\n{out.decode()[-2000:]}")
+    per_function = collections.Counter()
+    per_address = collections.Counter()  # of the functions that match lines_of
+    for tail, n in executed.items():
+        m = _TRACE.match(tail)
+        if m:
+            function = m.group(2).strip().decode(errors="replace") or "?"
+            addresses = blocks.get(int(m.group(1), 16), [])
+            per_function[function] += n * len(addresses)
+            if lines_of and lines_of.search(function):
+                for pc in addresses:
+                    per_address[pc] += n
+    return per_function, per_address
+
+
+def source_lines(elf, per_address):
+    """Executions per source line (addr2line: the innermost inlined line of each address)."""
+    pcs = sorted(per_address)
+    out = subprocess.run(["arm-none-eabi-addr2line", "-e", elf] + [hex(pc) for pc in pcs],
+                         capture_output=True, text=True, check=True).stdout.splitlines()
+    per_line = collections.Counter()
+    for pc, where in zip(pcs, out):
+        per_line[where.split(" ")[0].replace(os.getcwd() + "/", "")] += per_address[pc]
+    return per_line
+
+
+def demangle(names):
+    try:
+        out = subprocess.run(["c++filt"], input="\n".join(names), capture_output=True,
+                             text=True, check=True).stdout.splitlines()
+        return out if len(out) == len(names) else names
+    except (OSError, subprocess.CalledProcessError):
+        return names
+
+
+def main():
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p.add_argument("elf")
+    p.add_argument("--scenario", default="seed000_realistic")
+    p.add_argument("--controller", default="", help="dsmc, ifoc or iol (the scenario's if empty)")
+    p.add_argument("--from-ms", type=int, default=300)
+    p.add_argument("--to-ms", type=int, default=400)
+    p.add_argument("--rate-Hz", type=float, default=10000.0, help="the scenario's tick rate")
+    p.add_argument("--top", type=int, default=40)
+    p.add_argument("--lines", default="", help="a regex of (mangled) function names whose "
+                   "instructions are also listed by source line")
+    p.add_argument("--all", action="store_true", help="print every function")
+    a = p.parse_args()
+    if a.to_ms <= a.from_ms:
+        sys.exit("profile_pil: --to-ms must be after --from-ms")
+    with concurrent.futures.ThreadPoolExecutor(2) as pool:
+        lines_of = re.compile(a.lines) if a.lines else None
+        (early, early_pc), (late, late_pc) = pool.map(
+            lambda ms: run_counts(a.elf, a.scenario, a.controller, ms, lines_of),
+            (a.from_ms, a.to_ms))
+    ticks = (a.to_ms - a.from_ms) * 1e-3 * a.rate_Hz
+    diff = {f: (late[f] - early.get(f, 0)) / ticks for f in late}
+    rows = sorted(((v, f) for f, v in diff.items() if v > 0), reverse=True)
+    names = demangle([f for _, f in rows[:a.top]])
+    print(f"instructions per tick, {a.scenario} {a.controller or ''} "
+          f"{a.from_ms}..{a.to_ms} ms ({ticks:.0f} ticks); total {sum(diff.values()):.0f}")
+    for (v, _), name in zip(rows[:a.top], names):
+        print(f"{v:9.1f}  {name[:150]}")
+    if lines_of:
+        per_pc = {pc: late_pc[pc] - early_pc.get(pc, 0) for pc in late_pc}
+        per_line = source_lines(a.elf, {pc: n for pc, n in per_pc.items() if n > 0})
+        print(f"\ninstructions per tick by source line, functions matching {a.lines!r}")
+        for where, n in per_line.most_common(a.top):
+            print(f"{n / ticks:9.1f}  {where}")
+
+
+if __name__ == "__main__":
+    main()
