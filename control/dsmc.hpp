@@ -186,32 +186,42 @@ class Dsmc {
     T w_alpha = out.w_eq_alpha;
     T w_beta = flux_control(w_alpha, out);
     out.w_beta_tilde = w_beta;
-    if (!in.feasible.unlimited()) {
-      // Flux channel first: its bound is the range of lambda2^T v~ over the disk; the speed
-      // channel gets the range of lambda1^T v~ on the chord the flux control leaves. A
-      // saturated speed channel changes the flux control (through b_k and c_k: a large w_alpha
-      // costs flux), so it is solved again once; the final pass sets the flags.
-      for (int pass = 0; pass < 2; ++pass) {
-        const Interval beta = range_over_disk(lambda2, in.feasible);
-        out.w_beta_tilde = w_beta;
-        out.flux_saturated = !beta.contains(w_beta);
-        w_beta = beta.clamp(w_beta);
-        const Interval alpha = range_on_chord(lambda1, lambda2, w_beta, in.feasible);
-        out.speed_saturated = !alpha.contains(out.w_eq_alpha);
-        w_alpha = alpha.clamp(out.w_eq_alpha);
-        // The final w_alpha is clamped on the chord of the final w_beta, which was solved for
-        // the pass-0 w_alpha: the flux misses by at most b1^2 |v~|^2 (~6e-8 Wb^2 at 300 V).
-        if (pass == 0 && out.speed_saturated) {
-          w_beta = flux_control(w_alpha, out);
-        } else {
-          break;
-        }
+    // v~ = B^{-1} w = (-w_alpha J lambda2 + w_beta J lambda1) / det.
+    const auto input = [&](T wa, T wb) {
+      return Vec2<T>((J_times<T>(lambda1) * wb - J_times<T>(lambda2) * wa) / det);
+    };
+    out.v_AB_V = input(w_alpha, w_beta);
+    // Most ticks the solution lies well inside the disk, and neither channel can saturate:
+    // the ranges below (two square roots, a division) are computed only within a thousandth
+    // of the radius of its edge, where the clamps may act.
+    if (well_inside(out.v_AB_V, in.feasible)) {
+      out.w_alpha = w_alpha;
+      out.w_beta = w_beta;
+      return out;
+    }
+    // Flux channel first: its bound is the range of lambda2^T v~ over the disk; the speed
+    // channel gets the range of lambda1^T v~ on the chord the flux control leaves. A
+    // saturated speed channel changes the flux control (through b_k and c_k: a large w_alpha
+    // costs flux), so it is solved again once; the final pass sets the flags.
+    for (int pass = 0; pass < 2; ++pass) {
+      const Interval beta = range_over_disk(lambda2, in.feasible);
+      out.w_beta_tilde = w_beta;
+      out.flux_saturated = !beta.contains(w_beta);
+      w_beta = beta.clamp(w_beta);
+      const Interval alpha = range_on_chord(lambda1, lambda2, w_beta, in.feasible);
+      out.speed_saturated = !alpha.contains(out.w_eq_alpha);
+      w_alpha = alpha.clamp(out.w_eq_alpha);
+      // The final w_alpha is clamped on the chord of the final w_beta, which was solved for
+      // the pass-0 w_alpha: the flux misses by at most b1^2 |v~|^2 (~6e-8 Wb^2 at 300 V).
+      if (pass == 0 && out.speed_saturated) {
+        w_beta = flux_control(w_alpha, out);
+      } else {
+        break;
       }
     }
     out.w_alpha = w_alpha;
     out.w_beta = w_beta;
-    // v~ = B^{-1} w = (-w_alpha J lambda2 + w_beta J lambda1) / det.
-    out.v_AB_V = (J_times<T>(lambda1) * w_beta - J_times<T>(lambda2) * w_alpha) / det;
+    out.v_AB_V = input(w_alpha, w_beta);
     return out;
   }
 
@@ -231,6 +241,17 @@ class Dsmc {
   }
 
   /// Range of l^T v over the disk: l^T centre -/+ radius |l|.
+  /// Whether v lies inside the disk by more than 1e-3 of its radius (or the disk is the
+  /// whole plane). Then l2^T v = w_beta lies inside its range over the disk, and l1^T v = w_alpha
+  /// inside its range on the chord, by about 1e-3 r |l| each: for a well-conditioned B some 10^4
+  /// times the float rounding of v, so the clamps would leave w as it is. Near the edge the
+  /// ranges decide; either way the input is inside the disk.
+  static bool well_inside(const Vec2<T>& v, const InputDisk<T>& disk) noexcept {
+    if (disk.unlimited()) return true;
+    const T inner_V = disk.radius_V * T(0.999);
+    return (v - disk.center_V).squaredNorm() < inner_V * inner_V;  // false for NaN
+  }
+
   static Interval range_over_disk(const Vec2<T>& l, const InputDisk<T>& disk) noexcept {
     const T middle = l.dot(disk.center_V), half = disk.radius_V * l.norm();
     return {middle - half, middle + half};

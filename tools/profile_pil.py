@@ -77,13 +77,24 @@ def run_counts(elf, scenario, controller, duration_ms, lines_of=None):
 
 
 def source_lines(elf, per_address):
-    """Executions per source line (addr2line: the innermost inlined line of each address)."""
+    """Executions per source line: of each address, the innermost line in the project's own
+    files (addr2line -i lists the inlining chain; a library header's line, an Eigen operator or
+    std::min, is charged to the project line that inlined it)."""
     pcs = sorted(per_address)
-    out = subprocess.run(["arm-none-eabi-addr2line", "-e", elf] + [hex(pc) for pc in pcs],
-                         capture_output=True, text=True, check=True).stdout.splitlines()
+    out = subprocess.run(["arm-none-eabi-addr2line", "-a", "-i", "-e", elf] +
+                         [hex(pc) for pc in pcs], capture_output=True, text=True,
+                         check=True).stdout.splitlines()
+    chains, chain = [], None
+    for line in out:
+        if line.startswith("0x"):
+            chain = []
+            chains.append(chain)
+        elif chain is not None:
+            chain.append(line.split(" ")[0].replace(os.getcwd() + "/", ""))
     per_line = collections.Counter()
-    for pc, where in zip(pcs, out):
-        per_line[where.split(" ")[0].replace(os.getcwd() + "/", "")] += per_address[pc]
+    for pc, chain in zip(pcs, chains):
+        own = [where for where in chain if not where.startswith(("/usr/", "??"))]
+        per_line[own[0] if own else (chain[0] if chain else "?")] += per_address[pc]
     return per_line
 
 
