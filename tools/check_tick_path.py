@@ -26,7 +26,9 @@ within the limits below):
   (--exclude-object), whose second word is the entry point (the core's vectors), or that
   directly follow such a table (the chip's interrupt vectors).
 - Returns: `bx lr`, `pop {.., pc}`, `ldr pc, [sp], #N`, `ldm sp!, {.., pc}`. `tbb`/`tbh` stay
-  in the function. A linker veneer (`ldr pc, [pc, #imm]` loading a function's address) is a
+  in the function, and so does a switch's table jump at -Os (`adr rB, table` then
+  `ldr pc, [rB, rI, lsl #2]`) when every word of the table is a place in the function. A
+  linker veneer (`ldr pc, [pc, #imm]` loading a function's address) is a
   direct jump.
 - Limits: a function address made at run time any other way is not seen, nor is code that no
   FUNC symbol covers (a branch into it is reported on stderr).
@@ -72,6 +74,8 @@ TARGET_RE = re.compile(r'(?:^|[\s,])([0-9a-f]+) <')
 INSN_RE = re.compile(r'^\s*([0-9a-f]+):\s+(\S+)\s*(.*)$')
 SYM_RE = re.compile(r'^([0-9a-f]+) (.{7}) (\S+)\s+([0-9a-f]+)\s+'
                     r'(?:\.hidden |\.protected |\.internal )?(.*)$')
+ADR_RE = re.compile(r'\(adr (r\d+), ([0-9a-f]+)')  # objdump's comment on `add rN, pc, #imm`
+TABLE_JUMP_RE = re.compile(r'pc,\s*\[(r\d+),\s*r\d+,\s*lsl\s*#2\]$')
 REG_RE = re.compile(r'\b(r\d+|sp|lr|pc|ip|fp|sl|sb)\b')
 SEC_RE = re.compile(r'^\s*\d+\s+(\S+)\s+([0-9a-f]+)\s+([0-9a-f]+)\s+[0-9a-f]+\s+([0-9a-f]+)')
 
@@ -155,7 +159,16 @@ def build(args):
         i = bisect.bisect_right(starts, addr) - 1
         return funcs[starts[i]] if i >= 0 and addr < funcs[starts[i]].end else None
 
-    taken, pool_words, last, movw = set(), set(), {}, {}
+    taken, pool_words, last, movw, adr = set(), set(), {}, {}, {}
+
+    def switch_table(f, start):
+        """Whether the words from start (an `adr` address) are a jump table into f: at least
+        one, each a Thumb address inside f, up to the first word that is not."""
+        count = 0
+        while start is not None and (w := word_at(sections, start + 4 * count)) is not None \
+                and w & 1 and f.start <= (w & ~1) < f.end:
+            count += 1
+        return count > 0
     for line in objdump(args.objdump, '-d', '--no-show-raw-insn', args.elf).splitlines():
         m = INSN_RE.match(line)
         f = m and containing(int(m[1], 16))
@@ -178,12 +191,17 @@ def build(args):
             continue
         base = mn if mn.startswith('tb') else re.sub(rf'{COND}?(\.[nw])?$', '', mn)
         regs = REG_RE.findall(ops)
+        if table := ADR_RE.search(m[3]):
+            adr[(f.start, table[1])] = int(table[2], 16)
         if b or base == 'bx':  # blx rN, bx rN
             if ops != 'lr':
                 f.indirect_sites.append(addr)
         elif base in ('ldr', 'mov', 'add') and regs[:1] == ['pc']:
             if re.match(r'pc,\s*(\[sp\],\s*#\d+|lr)$', ops):
                 continue  # returns: ldr pc, [sp], #N (pop) and mov pc, lr
+            jump = TABLE_JUMP_RE.match(ops) if base == 'ldr' else None
+            if jump and switch_table(f, adr.get((f.start, jump[1]))):
+                continue  # a switch: its cases are in the function
             lit = re.match(r'pc,\s*\[pc(?:,\s*#(-?\d+))?\]$', ops) if base == 'ldr' else None
             value = word_at(sections, ((addr + 4) & ~3) + int(lit[1] or 0)) if lit else None
             if value is not None and value & 1 and (value & ~1) in funcs:

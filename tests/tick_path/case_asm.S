@@ -2,7 +2,8 @@
 @ see case_asm.cpp): a function that runs off its end into the next one, as libgcc's
 @ __aeabi_dsub does; a linker-style veneer (ldr pc, [pc, #imm]); a function address built
 @ with movw/movt, then called through a register; an interrupt vector with no symbol, which
-@ only the name of its section marks as a vector.
+@ only the name of its section marks as a vector; a switch's table jump as GCC writes it at
+@ -Os (adr, then ldr pc through the table), one of its cases calling a double function.
   .syntax unified
   .thumb
 
@@ -43,6 +44,30 @@ asm_movw_call:
   blx r3
   pop {r3, pc}
   .size asm_movw_call, .-asm_movw_call
+
+  .section .text.asm_switch,"ax",%progbits
+  .global asm_switch
+  .type asm_switch, %function
+  .thumb_func
+asm_switch:
+  push {r3, lr}
+  cmp r0, #2
+  bhi 3f
+  adr r1, 0f
+  ldr.w pc, [r1, r0, lsl #2]
+  .balign 4
+0:
+  .word 1f+1
+  .word 2f+1
+  .word 3f+1
+1:
+  bl far_double
+  pop {r3, pc}
+2:
+  adds r0, r0, #1
+3:
+  pop {r3, pc}
+  .size asm_switch, .-asm_switch
 
   @ No data object: only fixture_sections.ld, which keeps .isr_vector an output section,
   @ shows that this word is a vector (fixture_text.ld merges it into .text).

@@ -1,10 +1,11 @@
 // Roots for case_asm.S: SysTick_Handler -> asm_fall_a (falls into asm_fall_b -> malloc),
 // PendSV_Handler -> asm_veneer -> far_double, SVC_Handler -> asm_movw_call -> movw_target;
-// asm_irq_handler is in an interrupt vector.
+// asm_irq_handler is in an interrupt vector; asm_switch is a root by name.
 extern "C" {
 void asm_fall_a();
 void asm_veneer(float);
 void asm_movw_call(float);
+void asm_switch(int);
 
 volatile double g_result;
 
@@ -27,5 +28,8 @@ void PendSV_Handler() {
 void SVC_Handler() {
   asm_movw_call(2.0f);
 }
-void fixture_init() {}
+volatile int g_case;
+void fixture_init() {
+  asm_switch(g_case);  // keeps it in the image: the case roots it by name
+}
 }
