@@ -5,6 +5,7 @@
 #include <algorithm>
 
 #include "firmware/protocol/frame_codec.hpp"
+#include "hal/divide_u64.hpp"
 
 namespace imd::firmware {
 
@@ -27,7 +28,8 @@ Telemetry::Telemetry(uint8_t node_id, uint32_t period_ns, int rate_Hz,
     : node_id_(node_id),
       period_ns_(period_ns),
       us_per_count_(ns_per_count * 1e-3f),
-      ticks_per_10Hz_(std::max<uint64_t>(1, 100'000'000ull / period_ns)),
+      // 32-bit divisions: a 64-bit one is a library call on the MCU (hal/divide_u64.hpp).
+      ticks_per_10Hz_(std::max<uint32_t>(1, 100'000'000u / period_ns)),
       next_timing_k_(ticks_per_10Hz_ / 2) {
   if (!set_rate_Hz(rate_Hz)) set_rate_Hz(100);
 }
@@ -51,13 +53,14 @@ bool Telemetry::set_rate_Hz(int rate_Hz) noexcept {
   }
   rate_Hz_ = rate_Hz;
   // Nearest whole number of ticks; at 10 kHz every rate from 10 to 1000 Hz is within 5 %.
-  const uint64_t ticks = (1'000'000'000ull / uint64_t(rate_Hz) + period_ns_ / 2) / period_ns_;
-  fast_period_ticks_ = std::max<uint64_t>(1, ticks);
+  // Below 2^32: 10^9 / rate plus half a period of at most 2^32 - 1 ns.
+  const uint32_t ticks = (1'000'000'000u / uint32_t(rate_Hz) + period_ns_ / 2) / period_ns_;
+  fast_period_ticks_ = std::max<uint32_t>(1, ticks);
   return true;
 }
 
 uint32_t Telemetry::time_ms(uint64_t tick) const noexcept {
-  return static_cast<uint32_t>(tick * period_ns_ / 1'000'000ull);
+  return static_cast<uint32_t>(hal::divide_u64(tick * period_ns_, 1'000'000u));
 }
 
 void Telemetry::send(hal::CanBus& can, const hal::CanFrame& frame) noexcept {

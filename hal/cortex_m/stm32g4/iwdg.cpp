@@ -2,6 +2,7 @@
 
 #include "hal/cortex_m/armv7m.hpp"
 #include "hal/cortex_m/stm32g4/memory_map.hpp"
+#include "hal/divide_u64.hpp"
 
 namespace imd::hal::cortex_m::stm32g4 {
 namespace {
@@ -22,7 +23,7 @@ constexpr uint32_t kCsrIwdg = 1u << 29, kCsrWwdg = 1u << 30;
 
 void Iwdg::start(uint32_t timeout_us) noexcept {
   const uint32_t counts_per_s = kLsi_Hz / 4;
-  uint32_t reload = uint32_t(uint64_t(timeout_us) * counts_per_s / 1'000'000u);
+  uint32_t reload = uint32_t(divide_u64(uint64_t(timeout_us) * counts_per_s, 1'000'000u));
   reload = reload < 1 ? 1 : (reload > 0xFFF ? 0xFFF : reload);
   reg32(kKr) = kKeyStart;   // starts it (and the LSI)
   reg32(kKr) = kKeyUnlock;  // PR and RLR writable

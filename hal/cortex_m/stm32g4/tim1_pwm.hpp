@@ -19,6 +19,7 @@
 /// break settings are locked (LOCK level 1).
 #include <cstdint>
 
+#include "hal/divide_u64.hpp"
 #include "hal/pwm.hpp"
 
 namespace imd::hal::cortex_m::stm32g4 {
@@ -37,7 +38,8 @@ struct Tim1PwmConfig {
 /// The DTG code of TIMx_BDTR for a dead time (RM0440 §28.6, TIMx_BDTR), tDTS = timer clock (CKD =
 /// 00); rounded up to the next representable value, saturated at the largest (1008 tDTS).
 constexpr uint32_t dead_time_code(uint32_t dead_time_ns, uint32_t timer_clock_Hz) {
-  const uint64_t t = (uint64_t(dead_time_ns) * timer_clock_Hz + 999'999'999u) / 1'000'000'000u;
+  const uint64_t t =
+      divide_u64(uint64_t(dead_time_ns) * timer_clock_Hz + 999'999'999u, 1'000'000'000u);
   if (t <= 127) return uint32_t(t);                               // 0xxxxxxx: t
   if (t <= 2 * 127) return 0x80u | uint32_t((t + 1) / 2 - 64);    // 10xxxxxx: (64+x) 2
   if (t <= 8 * 63) return 0xC0u | uint32_t((t + 7) / 8 - 32);     // 110xxxxx: (32+x) 8
