@@ -56,7 +56,7 @@ if(IMD_ARM_NONE_EABI_CXX)
     SOURCE_DIR ${PROJECT_SOURCE_DIR}
     BINARY_DIR ${CMAKE_BINARY_DIR}/qemu-cortex-m4f
     CMAKE_ARGS -DCMAKE_TOOLCHAIN_FILE=${PROJECT_SOURCE_DIR}/toolchains/arm-none-eabi-cortex-m4f.cmake
-               -DCMAKE_BUILD_TYPE=Release "-DCMAKE_CXX_FLAGS_RELEASE=-O2 -DNDEBUG"
+               -DCMAKE_BUILD_TYPE=Release "-DCMAKE_CXX_FLAGS_RELEASE=-O2 -g -DNDEBUG"
                -DIMD_BUILD_TESTS=OFF -DIMD_BUILD_BENCHMARKS=OFF
     BUILD_COMMAND ${CMAKE_COMMAND} --build <BINARY_DIR> --target drive_pil_mps2_an386
     INSTALL_COMMAND ""
@@ -82,6 +82,11 @@ add_test(NAME qemu_pil_mps2_an386_ifoc
                  --scenario ${PROJECT_SOURCE_DIR}/hal_sim/scenarios/seed000_realistic.toml
                  --controller ifoc --work ${CMAKE_BINARY_DIR}/qemu-work-pil-ifoc)
 set_tests_properties(qemu_pil_mps2_an386_ifoc PROPERTIES LABELS qemu RUN_SERIAL ON TIMEOUT 900)
+# Instructions per tick by function and source line (tools/profile_pil.py) on the same image.
+add_test(NAME qemu_profile_pil
+         COMMAND /usr/bin/python3 ${CMAKE_CURRENT_SOURCE_DIR}/qemu/profile_pil_test.py
+                 --elf ${CMAKE_BINARY_DIR}/qemu-cortex-m4f/bin/drive_pil_mps2_an386.elf)
+set_tests_properties(qemu_profile_pil PROPERTIES LABELS qemu RUN_SERIAL ON TIMEOUT 900)
 # The same image at 20 kHz (hal_sim/scenarios/seed000_realistic_20kHz.toml, compiled in): no
 # overrun, the metrics within the float noise of the host's 20 kHz run, and the tick's share of
 # the 50 us period printed at 170 MHz with 1.5 cycles per instruction (docs/performance-tick.md,

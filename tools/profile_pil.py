@@ -26,11 +26,12 @@ _INSN = re.compile(rb"^0x([0-9a-f]+):  ")
 
 
 def run_counts(elf, scenario, controller, duration_ms, lines_of=None):
-    """Instructions executed per function over a run of duration_ms."""
+    """Instructions executed per function (and per address of the functions lines_of
+    matches) over a run of duration_ms, and the run's tick rate."""
     args = ["arg=pil", f"arg=scenario={scenario}", f"arg=duration_ms={duration_ms}"]
     if controller:
         args.append(f"arg=controller={controller}")
-    with tempfile.TemporaryDirectory() as tmp:
+    with tempfile.TemporaryDirectory() as tmp, tempfile.TemporaryFile() as console:
         fifo = os.path.join(tmp, "log")
         os.mkfifo(fifo)
         qemu = subprocess.Popen(
@@ -38,7 +39,7 @@ def run_counts(elf, scenario, controller, duration_ms, lines_of=None):
              "-monitor", "none", "-serial", "stdio",
              "-semihosting-config", "enable=on,target=native," + ",".join(args),
              "-icount", "shift=0,sleep=off", "-d", "in_asm,exec,nochain", "-D", fifo,
-             "-kernel", elf], stdout=subprocess.PIPE, stderr=subprocess.STDOUT)
+             "-kernel", elf], stdout=console, stderr=subprocess.STDOUT)
         blocks = {}  # a block's start address -> its instructions' addresses (last translation)
         executed = collections.Counter()  # a Trace line's "[.../pc/...] function" -> executions
         with open(fifo, "rb", buffering=1 << 20) as log:
@@ -59,9 +60,17 @@ def run_counts(elf, scenario, controller, duration_ms, lines_of=None):
                     blocks[start].append(pc)
                 else:
                     start = None
-        out, _ = qemu.communicate()
-        if b"pil end status" not in out or b"pil fault code none" not in out:
-            sys.exit(f"profile_pil: the run to {duration_ms} ms failed:\n{out.decode()[-2000:]}")
+        qemu.wait()
+        console.seek(0)
+        out = console.read().decode(errors="replace")
+    if "pil end status" not in out or "pil fault code none" not in out:
+        sys.exit(f"profile_pil: the run to {duration_ms} ms failed:\n{out[-2000:]}")
+    # The tick rate: the PIL clock's counts per period and its frequency.
+    period = re.search(r"counts_per_period (\d+)", out)
+    clock = re.search(r"clock_Hz (\d+)", out)
+    if not period or not clock:
+        sys.exit(f"profile_pil: the run to {duration_ms} ms printed no tick rate:\n{out[-2000:]}")
+    rate_Hz = int(clock[1]) / int(period[1])
     per_function = collections.Counter()
     per_address = collections.Counter()  # of the functions that match lines_of
     for tail, n in executed.items():
@@ -73,7 +82,7 @@ def run_counts(elf, scenario, controller, duration_ms, lines_of=None):
             if lines_of and lines_of.search(function):
                 for pc in addresses:
                     per_address[pc] += n
-    return per_function, per_address
+    return per_function, per_address, rate_Hz
 
 
 def source_lines(elf, per_address):
@@ -114,7 +123,6 @@ def main():
     p.add_argument("--controller", default="", help="dsmc, ifoc or iol (the scenario's if empty)")
     p.add_argument("--from-ms", type=int, default=300)
     p.add_argument("--to-ms", type=int, default=400)
-    p.add_argument("--rate-Hz", type=float, default=10000.0, help="the scenario's tick rate")
     p.add_argument("--top", type=int, default=40)
     p.add_argument("--lines", default="", help="a regex of (mangled) function names whose "
                    "instructions are also listed by source line")
@@ -124,10 +132,10 @@ def main():
         sys.exit("profile_pil: --to-ms must be after --from-ms")
     with concurrent.futures.ThreadPoolExecutor(2) as pool:
         lines_of = re.compile(a.lines) if a.lines else None
-        (early, early_pc), (late, late_pc) = pool.map(
+        (early, early_pc, _), (late, late_pc, rate_Hz) = pool.map(
             lambda ms: run_counts(a.elf, a.scenario, a.controller, ms, lines_of),
             (a.from_ms, a.to_ms))
-    ticks = (a.to_ms - a.from_ms) * 1e-3 * a.rate_Hz
+    ticks = (a.to_ms - a.from_ms) * 1e-3 * rate_Hz
     diff = {f: (late[f] - early.get(f, 0)) / ticks for f in late}
     rows = sorted(((v, f) for f, v in diff.items() if v > 0), reverse=True)
     names = demangle([f for _, f in rows[:a.top]])
