@@ -142,6 +142,35 @@ TEST_F(DsmcTest, OffCentreDiskBoundsTheInputExactly) {
   }
 }
 
+// The input is solved first and the channels' ranges over the disk are computed only within a
+// thousandth of the radius of its edge. Well inside, the result must be the unlimited law's to
+// the bit (no clamp can act there); just inside the edge the ranges are computed and must not
+// move an input that already fits (it stays within the rounding of v~ = B^-1 w, ~1e-9 V as
+// above); just outside it, the input is clamped onto the edge.
+TEST_F(DsmcTest, AnInputInsideTheDiskIsTheUnlimitedLawsOwn) {
+  const auto x = running();
+  auto in = input_for(x, 50.02, 0.2001, 0.7);
+  const auto free = dsmc.step(in);
+  ASSERT_EQ(free.status, DsmcStatus::ok);
+  const Vec2<double> centre(-40.0, 25.0);
+  const double distance = (free.v_AB_V - centre).norm();
+  for (const double radius : {2.0 * distance, distance * 1.0005, distance * 0.99}) {
+    in.feasible = {centre, radius};
+    const auto out = dsmc.step(in);
+    ASSERT_EQ(out.status, DsmcStatus::ok);
+    if (radius > distance * 1.001) {  // well inside: the shortcut
+      EXPECT_EQ(out.v_AB_V, free.v_AB_V);
+      EXPECT_FALSE(out.speed_saturated || out.flux_saturated);
+    } else if (radius > distance) {  // inside, near the edge: the ranges leave it
+      EXPECT_NEAR((out.v_AB_V - free.v_AB_V).norm(), 0.0, 1e-6);
+      EXPECT_FALSE(out.speed_saturated || out.flux_saturated);
+    } else {  // outside: clamped onto the edge
+      EXPECT_TRUE(out.speed_saturated || out.flux_saturated);
+      EXPECT_NEAR((out.v_AB_V - centre).norm(), radius, 1e-6);
+    }
+  }
+}
+
 TEST_F(DsmcTest, OffCentreDiskBoundsTheFluxChannel) {
   // A flux step the disk cannot deliver: the flux channel takes the disk's point that raises
   // |Phi_{k+1}|^2 most, c + r m/|m| with m = a11 Phi + a12 I (the flux without input).
