@@ -23,6 +23,7 @@ import tempfile
 
 _TRACE = re.compile(rb"^\[[0-9a-f]+/([0-9a-f]+)/[0-9a-f]+/[0-9a-f]+\] ?(.*)$")
 _INSN = re.compile(rb"^0x([0-9a-f]+):  ")
+_ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), "..")) + "/"  # the project
 
 
 def run_counts(elf, scenario, controller, duration_ms, lines_of=None):
@@ -99,7 +100,7 @@ def source_lines(elf, per_address):
             chain = []
             chains.append(chain)
         elif chain is not None:
-            chain.append(line.split(" ")[0].replace(os.getcwd() + "/", ""))
+            chain.append(line.split(" ")[0].replace(_ROOT, ""))
     per_line = collections.Counter()
     for pc, chain in zip(pcs, chains):
         own = [where for where in chain if not where.startswith(("/usr/", "??"))]
