@@ -72,6 +72,10 @@ class FluxFrameCurrentLoop {
     if (disk.unlimited()) return u;
     const Vec2<T>& c = disk.center_V;
     const T r = disk.radius_V > T(0) ? disk.radius_V : T(0);
+    // Inside the disk u is its own limit, to the bit: the clamps below would round c + (u - c)
+    // away from u on about one tick in thirteen and report a cut that did not happen (and the
+    // IFOC would undo its speed integrator's step). A NaN u fails the test and is clamped.
+    if ((u - c).squaredNorm() <= r * r) return u;
     const T d = std::clamp(u.x() - c.x(), -r, r);
     const T q_room = std::sqrt(std::max(r * r - d * d, T(0)));
     return Vec2<T>(c.x() + d, c.y() + std::clamp(u.y() - c.y(), -q_room, q_room));

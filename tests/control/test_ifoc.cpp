@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <random>
 
 #include "control/field_weakening.hpp"
 #include "control/flux_frame_current_loop.hpp"
@@ -175,6 +176,24 @@ TEST(IfocCurrentLoop, VoltageLimitKeepsTheFluxAxisFirst) {
   const Vec2<double> v = FluxFrameCurrentLoop<double>::limit_d_first({-30.0, 5.0}, disk);
   EXPECT_DOUBLE_EQ(v.x(), 1.0 - 10.0);
   EXPECT_DOUBLE_EQ(v.y(), -2.0);
+}
+
+// A voltage inside the disk is its own limit, to the bit. Clamped coordinate by coordinate
+// about an off-centre disk, c + (u - c) rounds away from u for about one voltage in thirteen
+// (uniform u within +-150 V, c within +-50 V): the loop would report a cut that did not happen,
+// and the IFOC would undo its speed integrator's step on that tick.
+TEST(IfocCurrentLoop, AVoltageInsideTheDiskIsNotCut) {
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> centre(-50.0, 50.0), voltage(-150.0, 150.0);
+  int inside = 0;
+  for (int i = 0; i < 10'000; ++i) {
+    const InputDisk<double> disk{Vec2<double>(centre(rng), centre(rng)), 180.0};
+    const Vec2<double> u(voltage(rng), voltage(rng));
+    if ((u - disk.center_V).norm() >= disk.radius_V) continue;
+    ++inside;
+    ASSERT_EQ(FluxFrameCurrentLoop<double>::limit_d_first(u, disk), u) << u.transpose();
+  }
+  EXPECT_GT(inside, 5'000);  // the disk holds most of the square
 }
 
 TEST(Ifoc, SlipAndFluxAngleMatchTheMotorInSteadyState) {
