@@ -240,18 +240,20 @@ class Dsmc {
     return b >= T(0) ? T(-2) * c / (b + root) : (root - b) / (T(2) * a);
   }
 
-  /// Range of l^T v over the disk: l^T centre -/+ radius |l|.
   /// Whether v lies inside the disk by more than 1e-3 of its radius (or the disk is the
-  /// whole plane). Then l2^T v = w_beta lies inside its range over the disk, and l1^T v = w_alpha
-  /// inside its range on the chord, by about 1e-3 r |l| each: for a well-conditioned B some 10^4
-  /// times the float rounding of v, so the clamps would leave w as it is. Near the edge the
-  /// ranges decide; either way the input is inside the disk.
+  /// whole plane). Then w_beta = l2^T v lies inside its range over the disk by about
+  /// 1e-3 r |l2|, and w_alpha = l1^T v inside its range on the chord by about
+  /// 1e-3 r |l1 x l2| / |l2|: for a well-conditioned B far above the float rounding of v, so the
+  /// clamps would leave w as it is. Near the edge the ranges decide; either way the input is
+  /// inside the disk. A zero, negative or NaN radius allows no shortcut (InputDisk::clamp).
   static bool well_inside(const Vec2<T>& v, const InputDisk<T>& disk) noexcept {
     if (disk.unlimited()) return true;
+    if (!(disk.radius_V > T(0))) return false;
     const T inner_V = disk.radius_V * T(0.999);
     return (v - disk.center_V).squaredNorm() < inner_V * inner_V;  // false for NaN
   }
 
+  /// Range of l^T v over the disk: l^T centre -/+ radius |l|.
   static Interval range_over_disk(const Vec2<T>& l, const InputDisk<T>& disk) noexcept {
     const T middle = l.dot(disk.center_V), half = disk.radius_V * l.norm();
     return {middle - half, middle + half};

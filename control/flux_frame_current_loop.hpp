@@ -72,9 +72,10 @@ class FluxFrameCurrentLoop {
     if (disk.unlimited()) return u;
     const Vec2<T>& c = disk.center_V;
     const T r = disk.radius_V > T(0) ? disk.radius_V : T(0);
-    // Inside the disk u is its own limit, to the bit: the clamps below would round c + (u - c)
-    // away from u on about one tick in thirteen and report a cut that did not happen (and the
-    // IFOC would undo its speed integrator's step). A NaN u fails the test and is clamped.
+    // Inside the disk u is its own limit, to the bit: for an off-centre disk the clamps below
+    // round c + (u - c) away from u (for 13 % of random voltages inside it) and would report a
+    // cut that did not happen, undoing the IFOC's speed integrator step. A NaN u fails the test
+    // and takes the clamps' path, as before.
     if ((u - c).squaredNorm() <= r * r) return u;
     const T d = std::clamp(u.x() - c.x(), -r, r);
     const T q_room = std::sqrt(std::max(r * r - d * d, T(0)));

@@ -103,7 +103,7 @@ void Telemetry::publish(uint64_t k, hal::CanBus& can, const TickRecord<T>& r,
   if (k >= next_timing_k_) {  // between heartbeats, to spread the load
     next_timing_k_ = next_due(next_timing_k_, k, ticks_per_10Hz_);
     send(can, encode_frame(node_id_, MessageId::timing,
-                           {float(execution.mean_whole_ns()) * 1e-3f, float(execution.max_ns) * 1e-3f,
+                           {execution.mean_us(), float(execution.max_ns) * 1e-3f,
                             float(std::min<uint64_t>(execution.overruns, 0xFFFF)),
                             float(budget_ns) * 1e-3f}));
     send_stage_timing(can, r.stage_counts);

@@ -91,7 +91,7 @@ set_tests_properties(qemu_profile_pil PROPERTIES LABELS qemu RUN_SERIAL ON TIMEO
 # overrun, the metrics within the float noise of the host's 20 kHz run, and the tick's share of
 # the 50 us period printed at 170 MHz with 1.5 cycles per instruction (docs/performance-tick.md,
 # "20 kHz"). The target is a quarter of the period, 1 416 instructions; the tick takes about
-# 2 590 today, so the share is reported, not checked: add --max-tick-share 0.25 once it fits.
+# 2 110 today, so the share is reported, not checked: add --max-tick-share 0.25 once it fits.
 add_test(NAME qemu_pil_mps2_an386_20kHz
          COMMAND /usr/bin/python3 ${CMAKE_CURRENT_SOURCE_DIR}/qemu/pil_test.py
                  --elf ${CMAKE_BINARY_DIR}/qemu-cortex-m4f/bin/drive_pil_mps2_an386.elf

@@ -26,9 +26,9 @@ within the limits below):
   (--exclude-object), whose second word is the entry point (the core's vectors), or that
   directly follow such a table (the chip's interrupt vectors).
 - Returns: `bx lr`, `pop {.., pc}`, `ldr pc, [sp], #N`, `ldm sp!, {.., pc}`. `tbb`/`tbh` stay
-  in the function, and so does a switch's table jump at -Os (`adr rB, table` then
-  `ldr pc, [rB, rI, lsl #2]`) when every word of the table is a place in the function. A
-  linker veneer (`ldr pc, [pc, #imm]` loading a function's address) is a
+  in the function, and so does a switch's table jump at -Os (`adr rB, table` right before
+  `ldr pc, [rB, rI, lsl #2]`) when the table's words, up to the first that is not, are places
+  in the function (at least one). A linker veneer (`ldr pc, [pc, #imm]` loading a function's address) is a
   direct jump.
 - Limits: a function address made at run time any other way is not seen, nor is code that no
   FUNC symbol covers (a branch into it is reported on stderr).
@@ -191,8 +191,9 @@ def build(args):
             continue
         base = mn if mn.startswith('tb') else re.sub(rf'{COND}?(\.[nw])?$', '', mn)
         regs = REG_RE.findall(ops)
+        after_adr = adr.pop(f.start, None)  # (register, address) of an adr just before
         if table := ADR_RE.search(m[3]):
-            adr[(f.start, table[1])] = int(table[2], 16)
+            adr[f.start] = (table[1], int(table[2], 16))
         if b or base == 'bx':  # blx rN, bx rN
             if ops != 'lr':
                 f.indirect_sites.append(addr)
@@ -200,7 +201,7 @@ def build(args):
             if re.match(r'pc,\s*(\[sp\],\s*#\d+|lr)$', ops):
                 continue  # returns: ldr pc, [sp], #N (pop) and mov pc, lr
             jump = TABLE_JUMP_RE.match(ops) if base == 'ldr' else None
-            if jump and switch_table(f, adr.get((f.start, jump[1]))):
+            if jump and after_adr and after_adr[0] == jump[1] and switch_table(f, after_adr[1]):
                 continue  # a switch: its cases are in the function
             lit = re.match(r'pc,\s*\[pc(?:,\s*#(-?\d+))?\]$', ops) if base == 'ldr' else None
             value = word_at(sections, ((addr + 4) & ~3) + int(lit[1] or 0)) if lit else None

@@ -20,8 +20,10 @@ import re
 import subprocess
 import sys
 import tempfile
+import threading
 
-_TRACE = re.compile(rb"^\[[0-9a-f]+/([0-9a-f]+)/[0-9a-f]+/[0-9a-f]+\] ?(.*)$")
+_TRACE = re.compile(rb"^\[[0-9a-f]+/([0-9a-f]+)/[0-9a-f]+/([0-9a-f]+)\] ?(.*)$")
+_CF_COUNT_MASK = 0x1FF  # QEMU's instruction limit of a block in its cflags (0: none)
 _INSN = re.compile(rb"^0x([0-9a-f]+):  ")
 _ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), "..")) + "/"  # the project
 
@@ -41,26 +43,35 @@ def run_counts(elf, scenario, controller, duration_ms, lines_of=None):
              "-semihosting-config", "enable=on,target=native," + ",".join(args),
              "-icount", "shift=0,sleep=off", "-d", "in_asm,exec,nochain", "-D", fifo,
              "-kernel", elf], stdout=console, stderr=subprocess.STDOUT)
-        blocks = {}  # a block's start address -> its instructions' addresses (last translation)
-        executed = collections.Counter()  # a Trace line's "[.../pc/...] function" -> executions
+        # QEMU may exit before it opens the log: open it then, so that the reader sees its end.
+        threading.Thread(target=_release_fifo, args=(qemu, fifo), daemon=True).start()
+        blocks = {}  # a block's start address -> its instructions' addresses (longest listing)
+        executed = collections.Counter()  # a Trace line's "[.../pc/.../cflags] function" -> runs
+        cut = collections.Counter()  # (Trace line, the I/O instruction it stopped at) -> times
         with open(fifo, "rb", buffering=1 << 20) as log:
-            start = None
+            listing, last = None, None
             for line in log:
                 if line.startswith(b"Trace "):
-                    executed[line[line.find(b"["):]] += 1  # parsed once per block below
-                elif line.startswith(b"IN:"):
-                    start = None
+                    last = line[line.find(b"["):]  # parsed once per block below
+                    executed[last] += 1
+                elif line.startswith(b"Stopped execution") and last is not None:
+                    executed[last] -= 1  # logged before it ran, then not run
+                    last = None
+                elif line.startswith(b"cpu_io_recompile: rewound") and last is not None:
+                    # -icount: a device access mid-block; the block ran up to that instruction,
+                    # which runs again, alone, and then the rest of the block as a new one.
+                    cut[(last, int(line.split()[-1], 16))] += 1
+                    last = None
                 elif line.startswith(b"0x"):
                     m = _INSN.match(line)
-                    if m is None:
-                        continue
-                    pc = int(m.group(1), 16)
-                    if start is None:
-                        start = pc
-                        blocks[start] = []
-                    blocks[start].append(pc)
-                else:
-                    start = None
+                    if m is not None:
+                        listing = listing if listing is not None else []
+                        listing.append(int(m.group(1), 16))
+                    continue
+                if listing:  # a listing ends at the first other line
+                    if len(listing) > len(blocks.get(listing[0], ())):
+                        blocks[listing[0]] = listing  # a shorter copy: a limited retranslation
+                listing = None
         qemu.wait()
         console.seek(0)
         out = console.read().decode(errors="replace")
@@ -74,16 +85,37 @@ def run_counts(elf, scenario, controller, duration_ms, lines_of=None):
     rate_Hz = int(clock[1]) / int(period[1])
     per_function = collections.Counter()
     per_address = collections.Counter()  # of the functions that match lines_of
-    for tail, n in executed.items():
-        m = _TRACE.match(tail)
-        if m:
-            function = m.group(2).strip().decode(errors="replace") or "?"
-            addresses = blocks.get(int(m.group(1), 16), [])
-            per_function[function] += n * len(addresses)
-            if lines_of and lines_of.search(function):
-                for pc in addresses:
-                    per_address[pc] += n
+    counted = [(tail, n, None) for tail, n in executed.items()]
+    counted += [(tail, -n, io_pc) for (tail, io_pc), n in cut.items()]
+    for tail, n, io_pc in counted:
+        function, addresses = _block(tail, blocks)
+        if io_pc is not None:  # a cut run: take back what it did not execute
+            addresses = addresses[addresses.index(io_pc):] if io_pc in addresses else []
+        per_function[function] += n * len(addresses)
+        if lines_of and lines_of.search(function):
+            for pc in addresses:
+                per_address[pc] += n
     return per_function, per_address, rate_Hz
+
+
+def _block(tail, blocks):
+    """The function of a Trace line and the instructions its block ran: the block's listing,
+    cut to the count its cflags carry when QEMU limited it (-icount's budget)."""
+    m = _TRACE.match(tail)
+    if m is None:
+        return "?", []
+    function = m.group(3).strip().decode(errors="replace") or "?"
+    addresses = blocks.get(int(m.group(1), 16), [])
+    limit = int(m.group(2), 16) & _CF_COUNT_MASK
+    return function, addresses[:limit] if limit else addresses
+
+
+def _release_fifo(qemu, fifo):
+    qemu.wait()
+    try:  # a reader still waiting in open() gets a writer and then the end of the file
+        os.close(os.open(fifo, os.O_WRONLY | os.O_NONBLOCK))
+    except OSError:
+        pass  # no reader waiting: it opened the log and reads to QEMU's end
 
 
 def source_lines(elf, per_address):
@@ -103,7 +135,7 @@ def source_lines(elf, per_address):
             chain.append(line.split(" ")[0].replace(_ROOT, ""))
     per_line = collections.Counter()
     for pc, chain in zip(pcs, chains):
-        own = [where for where in chain if not where.startswith(("/usr/", "??"))]
+        own = [where for where in chain if not where.startswith(("/", "??"))]  # not libraries
         per_line[own[0] if own else (chain[0] if chain else "?")] += per_address[pc]
     return per_line
 
@@ -127,7 +159,7 @@ def main():
     p.add_argument("--top", type=int, default=40)
     p.add_argument("--lines", default="", help="a regex of (mangled) function names whose "
                    "instructions are also listed by source line")
-    p.add_argument("--all", action="store_true", help="print every function")
+    p.add_argument("--all", action="store_true", help="print every function and line")
     a = p.parse_args()
     if a.to_ms <= a.from_ms:
         sys.exit("profile_pil: --to-ms must be after --from-ms")
@@ -139,16 +171,17 @@ def main():
     ticks = (a.to_ms - a.from_ms) * 1e-3 * rate_Hz
     diff = {f: (late[f] - early.get(f, 0)) / ticks for f in late}
     rows = sorted(((v, f) for f, v in diff.items() if v > 0), reverse=True)
-    names = demangle([f for _, f in rows[:a.top]])
+    top = len(rows) if a.all else a.top
+    names = demangle([f for _, f in rows[:top]])
     print(f"instructions per tick, {a.scenario} {a.controller or ''} "
           f"{a.from_ms}..{a.to_ms} ms ({ticks:.0f} ticks); total {sum(diff.values()):.0f}")
-    for (v, _), name in zip(rows[:a.top], names):
+    for (v, _), name in zip(rows[:top], names):
         print(f"{v:9.1f}  {name[:150]}")
     if lines_of:
         per_pc = {pc: late_pc[pc] - early_pc.get(pc, 0) for pc in late_pc}
         per_line = source_lines(a.elf, {pc: n for pc, n in per_pc.items() if n > 0})
         print(f"\ninstructions per tick by source line, functions matching {a.lines!r}")
-        for where, n in per_line.most_common(a.top):
+        for where, n in per_line.most_common(None if a.all else a.top):
             print(f"{n / ticks:9.1f}  {where}")
 
 

@@ -179,9 +179,9 @@ TEST(IfocCurrentLoop, VoltageLimitKeepsTheFluxAxisFirst) {
 }
 
 // A voltage inside the disk is its own limit, to the bit. Clamped coordinate by coordinate
-// about an off-centre disk, c + (u - c) rounds away from u for about one voltage in thirteen
+// about an off-centre disk, c + (u - c) rounds away from u for about 13 % of the voltages
 // (uniform u within +-150 V, c within +-50 V): the loop would report a cut that did not happen,
-// and the IFOC would undo its speed integrator's step on that tick.
+// and the IFOC would undo its speed integrator's step.
 TEST(IfocCurrentLoop, AVoltageInsideTheDiskIsNotCut) {
   std::mt19937_64 rng(7);
   std::uniform_real_distribution<double> centre(-50.0, 50.0), voltage(-150.0, 150.0);

@@ -3,7 +3,8 @@
 @ __aeabi_dsub does; a linker-style veneer (ldr pc, [pc, #imm]); a function address built
 @ with movw/movt, then called through a register; an interrupt vector with no symbol, which
 @ only the name of its section marks as a vector; a switch's table jump as GCC writes it at
-@ -Os (adr, then ldr pc through the table), one of its cases calling a double function.
+@ -Os (adr, then ldr pc through the table), one of its cases calling a double function; the
+@ same jump through a table whose word is another function's address (a call, not a switch).
   .syntax unified
   .thumb
 
@@ -68,6 +69,18 @@ asm_switch:
 3:
   pop {r3, pc}
   .size asm_switch, .-asm_switch
+
+  .section .text.asm_table_out,"ax",%progbits
+  .global asm_table_out
+  .type asm_table_out, %function
+  .thumb_func
+asm_table_out:
+  adr r1, 0f
+  ldr.w pc, [r1, r0, lsl #2]
+  .balign 4
+0:
+  .word movw_target           @ the linker sets the Thumb bit
+  .size asm_table_out, .-asm_table_out
 
   @ No data object: only fixture_sections.ld, which keeps .isr_vector an output section,
   @ shows that this word is a vector (fixture_text.ld merges it into .text).

@@ -1,11 +1,12 @@
 // Roots for case_asm.S: SysTick_Handler -> asm_fall_a (falls into asm_fall_b -> malloc),
 // PendSV_Handler -> asm_veneer -> far_double, SVC_Handler -> asm_movw_call -> movw_target;
-// asm_irq_handler is in an interrupt vector; asm_switch is a root by name.
+// asm_irq_handler is in an interrupt vector; asm_switch and asm_table_out are roots by name.
 extern "C" {
 void asm_fall_a();
 void asm_veneer(float);
 void asm_movw_call(float);
 void asm_switch(int);
+void asm_table_out(int);
 
 volatile double g_result;
 
@@ -30,6 +31,7 @@ void SVC_Handler() {
 }
 volatile int g_case;
 void fixture_init() {
-  asm_switch(g_case);  // keeps it in the image: the case roots it by name
+  asm_switch(g_case);  // keep them in the image: the cases root them by name
+  asm_table_out(g_case);
 }
 }
