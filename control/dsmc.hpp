@@ -193,8 +193,12 @@ class Dsmc {
     out.v_AB_V = input(w_alpha, w_beta);
     // Most ticks the solution lies well inside the disk, and neither channel can saturate:
     // the ranges below (two square roots, a division) are computed only within a thousandth
-    // of the radius of its edge, where the clamps may act.
-    if (well_inside(out.v_AB_V, in.feasible)) {
+    // of the radius of its edge, where the clamps may act. Inside by 1e-3 r, w_beta = l2^T v
+    // lies inside its range by about 1e-3 r |l2| and w_alpha = l1^T v inside its range on the
+    // chord by about 1e-3 r |l1 x l2| / |l2|: for a well-conditioned B far above the rounding
+    // of v, so the clamps would leave w as it is. A zero, negative or NaN radius contains
+    // nothing; the whole plane contains everything.
+    if (in.feasible.contains(out.v_AB_V, T(-1e-3) * in.feasible.radius_V)) {
       out.w_alpha = w_alpha;
       out.w_beta = w_beta;
       return out;
@@ -238,19 +242,6 @@ class Dsmc {
     using std::sqrt;
     const T root = sqrt(discriminant);
     return b >= T(0) ? T(-2) * c / (b + root) : (root - b) / (T(2) * a);
-  }
-
-  /// Whether v lies inside the disk by more than 1e-3 of its radius (or the disk is the
-  /// whole plane). Then w_beta = l2^T v lies inside its range over the disk by about
-  /// 1e-3 r |l2|, and w_alpha = l1^T v inside its range on the chord by about
-  /// 1e-3 r |l1 x l2| / |l2|: for a well-conditioned B far above the float rounding of v, so the
-  /// clamps would leave w as it is. Near the edge the ranges decide; either way the input is
-  /// inside the disk. A zero, negative or NaN radius allows no shortcut (InputDisk::clamp).
-  static bool well_inside(const Vec2<T>& v, const InputDisk<T>& disk) noexcept {
-    if (disk.unlimited()) return true;
-    if (!(disk.radius_V > T(0))) return false;
-    const T inner_V = disk.radius_V * T(0.999);
-    return (v - disk.center_V).squaredNorm() < inner_V * inner_V;  // false for NaN
   }
 
   /// Range of l^T v over the disk: l^T centre -/+ radius |l|.

@@ -69,14 +69,13 @@ class FluxFrameCurrentLoop {
 
   /// The point of the disk that keeps u_d if it can, then as much of u_q as is left.
   static Vec2<T> limit_d_first(const Vec2<T>& u, const InputDisk<T>& disk) noexcept {
-    if (disk.unlimited()) return u;
+    // Inside the disk (or without one) u is its own limit, to the bit: for an off-centre disk
+    // the clamps below round c + (u - c) away from u (for 13 % of random voltages inside it)
+    // and would report a cut that did not happen, undoing the IFOC's speed integrator step. A
+    // NaN u fails the test and takes the clamps' path, as before.
+    if (disk.contains(u)) return u;
     const Vec2<T>& c = disk.center_V;
     const T r = disk.radius_V > T(0) ? disk.radius_V : T(0);
-    // Inside the disk u is its own limit, to the bit: for an off-centre disk the clamps below
-    // round c + (u - c) away from u (for 13 % of random voltages inside it) and would report a
-    // cut that did not happen, undoing the IFOC's speed integrator step. A NaN u fails the test
-    // and takes the clamps' path, as before.
-    if ((u - c).squaredNorm() <= r * r) return u;
     const T d = std::clamp(u.x() - c.x(), -r, r);
     const T q_room = std::sqrt(std::max(r * r - d * d, T(0)));
     return Vec2<T>(c.x() + d, c.y() + std::clamp(u.y() - c.y(), -q_room, q_room));
