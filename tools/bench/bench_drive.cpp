@@ -5,6 +5,7 @@
 #include <benchmark/benchmark.h>
 
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <optional>
 #include <string>
@@ -17,6 +18,7 @@
 #include "hal_sim/scenario.hpp"
 #include "hal_sim/sim_board.hpp"
 #include "tools/bench/bench_main.hpp"
+#include "tools/bench/reference_ifoc.hpp"
 #include "tools/drive_sim/csv_writer.hpp"
 
 namespace {
@@ -114,6 +116,40 @@ BENCHMARK_CAPTURE(BM_DriveSim, rk6_format_g10/csv, "rk6", Output::csv, CsvFormat
 BENCHMARK_CAPTURE(BM_DriveSim, rk6_threaded/csv, "rk6", Output::csv, CsvFormatting::threaded)
     ->Unit(benchmark::kMillisecond)->UseRealTime();
 
+/// The yardstick (tools/bench/reference_ifoc.hpp): a plain RK4 IFOC loop at 10 us on the
+/// realistic scenario's motor, bus, current limit, speed sine and load square, for as long.
+/// The ratios below give drive_sim's speed against it, measured in the same run.
+void BM_ReferenceIfoc(benchmark::State& bench) {
+  const imd::sim::Scenario s = imd::sim::load_scenario(scenario_path("seed000_realistic.toml"));
+  imd::bench::ReferenceIfocCase c;
+  c.motor = s.motor;
+  c.flux_Wb = std::sqrt(0.2);  // the scenario's flux2_Wb2
+  c.v_max_V = s.v_bus_V / std::sqrt(3.0);
+  c.i_max_A = s.i_max_A;
+  c.speed_amplitude_rad_s = 100.0;  // the scenario's [reference.speed]
+  c.speed_frequency_Hz = 0.25;
+  c.load_high_Nm = 1.0;  // its [load]
+  c.load_period_s = 1.0;
+  c.duration_s = s.duration_s;
+  c.sample_period_s = s.sample_period_s;
+  c.substeps = 10;
+  for (auto _ : bench) {
+    const imd::bench::ReferenceIfocResult r = imd::bench::run_reference_ifoc(c);
+    // It must have driven the motor: a 10 Hz speed loop follows a 0.25 Hz sine of 100 rad/s
+    // within a few rad/s (the load steps' dips included); a loop that did nothing would miss
+    // by the sine's RMS, 71 rad/s.
+    if (r.ticks != std::lround(c.duration_s / c.sample_period_s) ||
+        !(r.speed_error_rms_rad_s < 10.0)) {
+      bench.SkipWithError("the reference IFOC did not follow its speed reference");
+      break;
+    }
+    bench.counters["speed_error_rms_rad_s"] = r.speed_error_rms_rad_s;
+  }
+  bench.counters["sim_s_per_wall_s"] =
+      benchmark::Counter(c.duration_s * double(bench.iterations()), benchmark::Counter::kIsRate);
+}
+BENCHMARK(BM_ReferenceIfoc)->Unit(benchmark::kMillisecond)->UseRealTime();
+
 /// The realistic drive, enabled and brought to the running state on the board; then each
 /// iteration is one period, and only the tick is timed (manual time: the plant advances between
 /// the clock reads, so that the running drive sees a moving motor; a drive ticked against a
@@ -177,5 +213,8 @@ int main(int argc, char** argv) {
        {"BM_DriveSim/rk4_fmt_per_row/csv", "BM_DriveSim/rk6_to_chars/csv"},
        {"BM_DriveSim/rk6_to_chars/csv", "BM_DriveSim/rk6_format_g10/csv"},
        {"BM_DriveSim/rk6_to_chars/csv", "BM_DriveSim/rk6_threaded/csv"},
-       {"BM_DriveSim/rk6_to_chars/csv", "BM_DriveSim/rk6/no_output"}});
+       {"BM_DriveSim/rk6_to_chars/csv", "BM_DriveSim/rk6/no_output"},
+       // drive_sim against the plain RK4 IFOC loop: below 1, drive_sim is the slower.
+       {"BM_ReferenceIfoc", "BM_DriveSim/rk6/no_output"},
+       {"BM_ReferenceIfoc", "BM_DriveSim/rk6_threaded/csv"}});
 }
