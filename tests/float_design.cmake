@@ -20,6 +20,9 @@ foreach(name test_protection test_supervisor test_protection_checks test_limitat
 endforeach()
 imd_add_test(test_motor_record unit LIBRARIES imd_firmware tomlplusplus::tomlplusplus
              SOURCES firmware/test_motor_record.cpp)
+imd_add_test(test_estimate_stage unit LIBRARIES imd_firmware tomlplusplus::tomlplusplus
+             SOURCES firmware/test_estimate_stage.cpp)
+target_compile_options(test_estimate_stage PRIVATE -ffp-contract=off)  # bit-for-bit (the test)
 foreach(name test_voltage_fed_scenarios test_current_fed_scenarios test_rotor_resistance_tracking
              test_dsmc_torque_channel test_fault_matrix test_field_weakening test_phase_loss_sweep
              test_stop_categories test_fault_recovery test_encoder_check_sweep
@@ -34,7 +37,7 @@ set(IMD_FLOAT_DESIGN_TESTS
     test_drive_identification test_heartbeat_brake test_standstill_identification
     test_inertia_identification test_protection test_supervisor test_protection_checks
     test_limitation test_stop_category test_sense_stage test_protocol test_binary64
-    test_motor_record test_voltage_fed_scenarios test_current_fed_scenarios
+    test_motor_record test_estimate_stage test_voltage_fed_scenarios test_current_fed_scenarios
     test_rotor_resistance_tracking test_dsmc_torque_channel test_fault_matrix
     test_field_weakening test_phase_loss_sweep test_stop_categories test_fault_recovery
     test_encoder_check_sweep test_adc_stuck_sweep test_commissioning_scenarios

@@ -90,6 +90,16 @@ class ObserverEstimator final : public StateEstimator<T> {
     flux_.update(i_s_AB_A_, v_acting_AB_V);
   }
 
+  /// advance() when the exact model has already predicted step k+1 from this tick's estimate
+  /// (its flux, current, speed, position and load) with the voltage that acts over [k, k+1]:
+  /// the latency predictor's `next` (position not wrapped). The same rows, not computed twice.
+  void advance_to(const control::RotorFrameState<T>& next) noexcept {
+    encoder_.predicted(next.omega_mech_rad_s, next.theta_mech_rad);
+    i_next_AB_A_ = next.i_s_AB_A;
+    predicted_ = true;
+    flux_.predicted(next.flux_r_AB_Wb);
+  }
+
   /// Takes over the state of the object this one replaces (the same motor but for its
   /// rotor resistance): the tick changes coefficients and keeps state (docs/robustness.md).
   void continue_from(const ObserverEstimator& old) noexcept {

@@ -21,9 +21,21 @@ class LatencyPredictor {
   bool predicts() const noexcept { return predict_; }
 
   /// Sets e.x_input, the state the input of this tick will act on.
-  void set_input_state(Estimate<T>& e) const noexcept {
-    e.x_input = predict_ ? model_.predict(e.x, v_in_flight_V_, e.load_Nm) : e.x;
+  void set_input_state(Estimate<T>& e) noexcept {
+    if (predict_) {
+      next_ = model_.predict(e.x, v_in_flight_V_, e.load_Nm);
+      e.x_input = next_;
+    } else {
+      e.x_input = e.x;
+    }
     e.x_input.theta_mech_rad = control::wrap_pi(e.x_input.theta_mech_rad);
+  }
+
+  /// With latency, the state set_input_state() predicted for step k+1, position not wrapped:
+  /// the voltage in flight is the one that acts over [k, k+1], so this is also where the
+  /// observers advance to (before this tick's write; null without a prediction).
+  const control::RotorFrameState<T>* next_state() const noexcept {
+    return predict_ ? &next_ : nullptr;
   }
 
   /// This tick's voltage `v_V` is written (zero if the PWM is off). Returns the voltage acting
@@ -58,6 +70,7 @@ class LatencyPredictor {
   bool latency_, predict_;
   control::Vec2<T> v_in_flight_V_ = control::Vec2<T>::Zero();  ///< written last tick
   control::Vec2<T> u_in_flight_V_ = control::Vec2<T>::Zero();  ///< its stator voltage
+  control::RotorFrameState<T> next_;  ///< the last prediction
 };
 
 }  // namespace imd::firmware
