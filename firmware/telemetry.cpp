@@ -84,31 +84,23 @@ template <typename T>
 void Telemetry::publish(uint64_t k, hal::CanBus& can, const TickRecord<T>& r,
                         const DriveStatus& status, const StateMachine& machine,
                         const ExecutionStats& execution, uint32_t budget_ns) noexcept {
-  send_state_changes(can, machine);
+  send_state_changes(can, machine);  // events go at once
   if (k >= next_heartbeat_k_) {
-    send_heartbeat(can, status, machine);
-    if (status.identify_step != kNoIdentification) {  // a commissioning ran: its progress
-      const float seconds = float(k - status.identify_start_tick) * float(period_ns_) * 1e-9f;
-      send(can, encode_frame(node_id_, MessageId::identify_progress,
-                             {float(status.identify_step), status.identify_fraction,
-                              float(status.identify_failure), seconds}));
-    }
     next_heartbeat_k_ = next_due(next_heartbeat_k_, k, ticks_per_10Hz_);
+    pending_ |= kHeartbeatDue;
+    // A commissioning ran: its progress with each heartbeat.
+    if (status.identify_step != kNoIdentification) pending_ |= kIdentifyProgressDue;
     // Every tenth heartbeat, so that a host that joins the bus later learns the version too.
     if (++heartbeats_since_version_ >= kHeartbeatsPerVersion) {
       heartbeats_since_version_ = 0;
-      send_version(can);
+      pending_ |= kVersionDue;
     }
   }
   if (k >= next_timing_k_) {  // between heartbeats, to spread the load
     next_timing_k_ = next_due(next_timing_k_, k, ticks_per_10Hz_);
-    send(can, encode_frame(node_id_, MessageId::timing,
-                           {execution.mean_us(), float(execution.max_ns) * 1e-3f,
-                            float(std::min<uint64_t>(execution.overruns, 0xFFFF)),
-                            float(budget_ns) * 1e-3f}));
-    send_stage_timing(can, r.stage_counts);
+    pending_ |= kTimingDue | kStageTiming1Due | kStageTiming2Due;
   }
-  if (k >= next_fast_k_) {
+  if (k >= next_fast_k_) {  // a fast sample: its three frames together, nothing else
     next_fast_k_ = next_due(next_fast_k_, k, fast_period_ticks_);
     send(can, encode_frame(node_id_, MessageId::telemetry_speed_flux,
                            {float(r.omega_est_rad_s), float(r.omega_ref_rad_s),
@@ -120,6 +112,41 @@ void Telemetry::publish(uint64_t k, hal::CanBus& can, const TickRecord<T>& r,
     send(can, encode_frame(node_id_, MessageId::telemetry_voltage,
                            {float(r.u_alphabeta_V.x()), float(r.u_alphabeta_V.y()),
                             float(sample_count_++), float(r.rr_scale)}));
+    if (fast_period_ticks_ > 1) return;  // a sample every tick leaves no other: share it
+  }
+  if (pending_ == 0) return;
+  // The other cyclic frames one a tick, on ticks without a fast sample, the first due in
+  // this order: a frame costs the tick hundreds of instructions, and the frames due together
+  // (a heartbeat, the version, the fast sample) would make one tick several times as long as
+  // the others. Each carries the values of the tick it is sent in.
+  const uint16_t due = pending_ & uint16_t(-pending_);  // the lowest bit set
+  pending_ = uint16_t(pending_ & ~due);
+  switch (due) {
+    case kHeartbeatDue:
+      send_heartbeat(can, status, machine);
+      break;
+    case kIdentifyProgressDue: {
+      const float seconds = float(k - status.identify_start_tick) * float(period_ns_) * 1e-9f;
+      send(can, encode_frame(node_id_, MessageId::identify_progress,
+                             {float(status.identify_step), status.identify_fraction,
+                              float(status.identify_failure), seconds}));
+      break;
+    }
+    case kVersionDue:
+      send_version(can);
+      break;
+    case kTimingDue:
+      send(can, encode_frame(node_id_, MessageId::timing,
+                             {execution.mean_us(), float(execution.max_ns) * 1e-3f,
+                              float(std::min<uint64_t>(execution.overruns, 0xFFFF)),
+                              float(budget_ns) * 1e-3f}));
+      break;
+    case kStageTiming1Due:
+    case kStageTiming2Due:
+      send_stage_timing(can, r.stage_counts, due == kStageTiming1Due ? 0 : 4);
+      break;
+    default:
+      break;
   }
 }
 
@@ -130,12 +157,12 @@ template void Telemetry::publish(uint64_t, hal::CanBus&, const TickRecord<double
                                  const DriveStatus&, const StateMachine&, const ExecutionStats&,
                                  uint32_t) noexcept;
 
-void Telemetry::send_stage_timing(hal::CanBus& can, const StageCounts& c) noexcept {
+void Telemetry::send_stage_timing(hal::CanBus& can, const StageCounts& c, int first) noexcept {
   const float u = us_per_count_;
-  send(can, encode_frame(node_id_, MessageId::stage_timing_1,
-                         {float(c[0]) * u, float(c[1]) * u, float(c[2]) * u, float(c[3]) * u}));
-  send(can, encode_frame(node_id_, MessageId::stage_timing_2,
-                         {float(c[4]) * u, float(c[5]) * u, float(c[6]) * u, float(c[7]) * u}));
+  send(can, encode_frame(node_id_,
+                         first == 0 ? MessageId::stage_timing_1 : MessageId::stage_timing_2,
+                         {float(c[first]) * u, float(c[first + 1]) * u, float(c[first + 2]) * u,
+                          float(c[first + 3]) * u}));
 }
 
 void Telemetry::final_heartbeat(hal::CanBus& can, const DriveStatus& status,

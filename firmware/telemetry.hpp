@@ -1,7 +1,8 @@
 #pragma once
 /// What the drive sends on CAN, and when (docs/can/protocol.md): the heartbeat and the timing
-/// frame at 10 Hz, fast telemetry at a configurable 10..1000 Hz (three frames per sample, the
-/// voltage frame last), and event frames for state changes, faults and command results. The
+/// frame at 10 Hz, fast telemetry at a configurable 10..1000 Hz (three frames per sample, in
+/// one tick, the voltage frame last), and event frames for state changes, faults and command
+/// results. A tick sends the fast sample or one other cyclic frame, never both. The
 /// version frame goes first at each start, before whatever frame the drive sends first, and
 /// then with every tenth heartbeat.
 /// Frames go to the HAL's non-blocking transmit queue; a full queue drops the frame and counts
@@ -53,7 +54,9 @@ class Telemetry {
   bool set_rate_Hz(int rate_Hz) noexcept;
   int rate_Hz() const noexcept { return rate_Hz_; }
 
-  /// The cyclic frames due at tick k, and a state_change frame for each new transition.
+  /// A state_change frame for each new transition; then the fast sample's three frames if one
+  /// is due at tick k, or else the first of the other cyclic frames due by k and not yet sent
+  /// (one a tick: frames due together go out on the ticks that follow, in a fixed order).
   /// T: the drive's arithmetic (float and double are instantiated).
   template <typename T>
   void publish(uint64_t k, hal::CanBus& can, const TickRecord<T>& record, const DriveStatus& status,
@@ -82,7 +85,14 @@ class Telemetry {
   void send_heartbeat(hal::CanBus& can, const DriveStatus& status,
                       const StateMachine& machine) noexcept;
   uint32_t time_ms(uint64_t tick) const noexcept;
-  void send_stage_timing(hal::CanBus& can, const StageCounts& counts) noexcept;
+  /// stage_timing_1 (`first` 0: the first four stages) or stage_timing_2 (4: the last four).
+  void send_stage_timing(hal::CanBus& can, const StageCounts& counts, int first) noexcept;
+
+  // The cyclic frames due and not yet sent, one bit each; publish() sends the lowest first.
+  static constexpr uint16_t kHeartbeatDue = 1u << 0, kIdentifyProgressDue = 1u << 1,
+                            kVersionDue = 1u << 2, kTimingDue = 1u << 3,
+                            kStageTiming1Due = 1u << 4, kStageTiming2Due = 1u << 5;
+  uint16_t pending_ = 0;
 
   uint8_t node_id_;
   uint32_t period_ns_;
@@ -90,8 +100,9 @@ class Telemetry {
   uint64_t ticks_per_10Hz_;
   uint64_t fast_period_ticks_ = 1;
   // The ticks at which the cyclic frames are due next (heartbeat at 0, the timing frame
-  // half a heartbeat period later, fast telemetry at 0); a new rate applies from the next.
-  uint64_t next_heartbeat_k_ = 0, next_timing_k_, next_fast_k_ = 0;
+  // half a heartbeat period later, fast telemetry at 1: the first ticks send the version and
+  // the heartbeat, then the first sample); a new rate applies from the next.
+  uint64_t next_heartbeat_k_ = 0, next_timing_k_, next_fast_k_ = 1;
   int rate_Hz_ = 100;
   uint8_t heartbeat_count_ = 0;
   uint8_t sample_count_ = 0;

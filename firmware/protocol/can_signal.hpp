@@ -72,24 +72,37 @@ constexpr Signal with_range(Signal s, float min, float max) noexcept {
 
 using Payload = std::array<uint8_t, 8>;
 
-/// The raw bits of a signal (sign-extended for signed signals).
-constexpr int64_t get_raw(const Payload& data, const Signal& s) noexcept {
+/// The mask of a signal's bits, from bit 0.
+constexpr uint64_t field_mask(const Signal& s) noexcept {
+  return s.length_bits >= 64 ? ~uint64_t(0) : (uint64_t(1) << s.length_bits) - 1;
+}
+
+/// The raw bits of a signal in their place in the payload read as one little-endian word.
+constexpr uint64_t placed(const Signal& s, int64_t raw) noexcept {
+  return (static_cast<uint64_t>(raw) & field_mask(s)) << s.start_bit;
+}
+
+/// The payload as one little-endian word, and back.
+constexpr uint64_t payload_word(const Payload& data) noexcept {
   uint64_t bits = 0;
   for (int i = 0; i < 8; ++i) bits |= uint64_t(data[i]) << (8 * i);
-  const uint64_t mask = s.length_bits >= 64 ? ~uint64_t(0) : (uint64_t(1) << s.length_bits) - 1;
-  uint64_t raw = (bits >> s.start_bit) & mask;
+  return bits;
+}
+constexpr void set_payload_word(Payload& data, uint64_t bits) noexcept {
+  for (int i = 0; i < 8; ++i) data[i] = static_cast<uint8_t>(bits >> (8 * i));
+}
+
+/// The raw bits of a signal (sign-extended for signed signals).
+constexpr int64_t get_raw(const Payload& data, const Signal& s) noexcept {
+  const uint64_t mask = field_mask(s);
+  uint64_t raw = (payload_word(data) >> s.start_bit) & mask;
   if (s.is_signed && s.length_bits < 64 && (raw >> (s.length_bits - 1)) != 0) raw |= ~mask;
   return static_cast<int64_t>(raw);
 }
 
 /// Writes the raw bits of a signal; `raw` must be within [raw_min, raw_max].
 constexpr void set_raw(Payload& data, const Signal& s, int64_t raw) noexcept {
-  uint64_t bits = 0;
-  for (int i = 0; i < 8; ++i) bits |= uint64_t(data[i]) << (8 * i);
-  const uint64_t mask = s.length_bits >= 64 ? ~uint64_t(0) : (uint64_t(1) << s.length_bits) - 1;
-  bits &= ~(mask << s.start_bit);
-  bits |= (static_cast<uint64_t>(raw) & mask) << s.start_bit;
-  for (int i = 0; i < 8; ++i) data[i] = static_cast<uint8_t>(bits >> (8 * i));
+  set_payload_word(data, (payload_word(data) & ~(field_mask(s) << s.start_bit)) | placed(s, raw));
 }
 
 /// The physical value of a signal, in single precision (what the MCU decodes with).
@@ -119,12 +132,14 @@ inline int64_t to_raw(const Signal& s, float value) noexcept {
   return float_to_int64(raw);
 }
 
+/// The raw value a physical value is sent as: a float's bits (NaN and infinities pass as they
+/// are), else to_raw.
+inline int64_t raw_of(const Signal& s, float value) noexcept {
+  return s.is_float ? int64_t{std::bit_cast<uint32_t>(value)} : to_raw(s, value);
+}
+
 inline void set_physical(Payload& data, const Signal& s, float value) noexcept {
-  if (s.is_float) {
-    set_raw(data, s, std::bit_cast<uint32_t>(value));  // NaN and infinities pass as they are
-    return;
-  }
-  set_raw(data, s, to_raw(s, value));
+  set_raw(data, s, raw_of(s, value));
 }
 
 /// Whether a physical value is representable without saturation (any float in a float signal).

@@ -16,11 +16,17 @@ inline hal::CanFrame encode_frame(uint8_t node_id, MessageId id,
   hal::CanFrame frame;
   frame.id = can_id(node_id, id);
   frame.length = m.length;
+  // The signals do not overlap (tests/firmware/test_protocol.cpp): each is or-ed into one word,
+  // written out once (a read-modify-write of the payload per signal cost about 300
+  // instructions each on the MCU, in 64-bit shifts).
+  uint64_t bits = 0;
   std::size_t i = 0;
   for (const float value : values) {
     if (i >= m.signals.size()) break;
-    set_physical(frame.data, m.signals[i++], value);
+    const Signal& s = m.signals[i++];
+    bits |= placed(s, raw_of(s, value));
   }
+  set_payload_word(frame.data, bits);
   return frame;
 }
 

@@ -39,8 +39,11 @@ class PilReport {
   /// Prints each stage's mean counts per tick.
   void stages(const sim::StageTotals& totals, uint32_t clock_Hz) noexcept;
   /// Prints the summary; returns the exit status (0: no fault, no overrun, metrics measured).
+  /// `whole_tick`: the control stage from its start to its end (the drive's own figure ends
+  /// at the PWM write), and the tick that took longest in it.
   int finish(const Drive<float>& drive, const hal::cortex_m::TwoStageTick& timer,
-             const sim::TickObserver<float>& observer, uint64_t frames_sent) noexcept;
+             const sim::TickObserver<float>& observer, uint64_t frames_sent,
+             const ExecutionStats& whole_tick, uint64_t longest_tick) noexcept;
 
  private:
   void metric(const char* name, double value) noexcept;
