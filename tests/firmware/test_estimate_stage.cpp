@@ -28,7 +28,7 @@ TYPED_TEST(EstimateStage, AdvancingToThePredictionEqualsAdvancingByTheModel) {
   for (const test::TestMotor& motor : test::test_motors()) {
     const auto c = control::discretize_voltage_fed(motor.parameters, 1e-4);
     for (int trial = 0; trial < 100; ++trial) {
-      ObserverEstimator<T> by_model(c, motor.parameters.pole_pairs, 400.0);
+      ObserverEstimator<T> by_model(c, Real(motor.parameters.pole_pairs), Real(400.0));
       ObserverEstimator<T> to_prediction = by_model;
       LatencyPredictor<T> predictor(c, 1, true);
       const auto random_current = [&] {
