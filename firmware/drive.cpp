@@ -190,10 +190,8 @@ inline void Drive<T>::after_write(const Measurement<T>& m, const Estimate<T>& e,
     observers_due_ = false;
     if (substitutes_.estimator != nullptr) {
       substitutes_.estimator->advance(v_acting_V_);
-    } else if (const auto* next = model->predictor.next_state()) {
-      // With latency the voltage acting now was in flight when the estimate was made: the
-      // predictor has already taken the observers' step (the same model, state and voltage).
-      model->observers.advance_to(*next);
+    } else if (const auto* next = model->predictor.next_state()) {  // latency: step taken
+      model->observers.advance_to(*next);  // by the predictor (same model, state and voltage)
     } else {
       model->observers.advance(v_acting_V_);
     }

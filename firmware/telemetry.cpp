@@ -99,8 +99,10 @@ void Telemetry::publish(uint64_t k, hal::CanBus& can, const TickRecord<T>& r,
   if (k >= next_timing_k_) {  // between heartbeats, to spread the load
     next_timing_k_ = next_due(next_timing_k_, k, ticks_per_10Hz_);
     pending_ |= kTimingDue | kStageTiming1Due | kStageTiming2Due;
+    timed_stages_ = r.stage_counts;  // both stage-timing frames from the same tick
   }
-  if (k >= next_fast_k_) {  // a fast sample: its three frames together, nothing else
+  bool sample = false;
+  if (k >= next_fast_k_) {  // a fast sample: its three frames together
     next_fast_k_ = next_due(next_fast_k_, k, fast_period_ticks_);
     send(can, encode_frame(node_id_, MessageId::telemetry_speed_flux,
                            {float(r.omega_est_rad_s), float(r.omega_ref_rad_s),
@@ -112,15 +114,32 @@ void Telemetry::publish(uint64_t k, hal::CanBus& can, const TickRecord<T>& r,
     send(can, encode_frame(node_id_, MessageId::telemetry_voltage,
                            {float(r.u_alphabeta_V.x()), float(r.u_alphabeta_V.y()),
                             float(sample_count_++), float(r.rr_scale)}));
-    if (fast_period_ticks_ > 1) return;  // a sample every tick leaves no other: share it
+    sample = true;
   }
-  if (pending_ == 0) return;
-  // The other cyclic frames one a tick, on ticks without a fast sample, the first due in
-  // this order: a frame costs the tick hundreds of instructions, and the frames due together
-  // (a heartbeat, the version, the fast sample) would make one tick several times as long as
-  // the others. Each carries the values of the tick it is sent in.
-  const uint16_t due = pending_ & uint16_t(-pending_);  // the lowest bit set
-  pending_ = uint16_t(pending_ & ~due);
+  // A frame costs the tick hundreds of instructions: with enough ticks between the 10 Hz
+  // frames, the other cyclic frames go one a tick, on ticks without a sample (unless a sample
+  // takes every tick), the first due in this order; each carries its tick's values. A slower
+  // loop has the time to send them all at once, and too few ticks to spread them.
+  const bool spread = ticks_per_10Hz_ >= kSpreadMinTicks;
+  if (spread && sample && fast_period_ticks_ > 1) return;
+  while (pending_ != 0) {
+    const uint16_t due = pending_ & uint16_t(-pending_);  // the lowest bit set
+    pending_ = uint16_t(pending_ & ~due);
+    send_cyclic(due, k, can, status, machine, execution, budget_ns);
+    if (spread) break;
+  }
+}
+
+template void Telemetry::publish(uint64_t, hal::CanBus&, const TickRecord<float>&,
+                                 const DriveStatus&, const StateMachine&, const ExecutionStats&,
+                                 uint32_t) noexcept;
+template void Telemetry::publish(uint64_t, hal::CanBus&, const TickRecord<double>&,
+                                 const DriveStatus&, const StateMachine&, const ExecutionStats&,
+                                 uint32_t) noexcept;
+
+void Telemetry::send_cyclic(uint16_t due, uint64_t k, hal::CanBus& can, const DriveStatus& status,
+                            const StateMachine& machine, const ExecutionStats& execution,
+                            uint32_t budget_ns) noexcept {
   switch (due) {
     case kHeartbeatDue:
       send_heartbeat(can, status, machine);
@@ -143,19 +162,12 @@ void Telemetry::publish(uint64_t k, hal::CanBus& can, const TickRecord<T>& r,
       break;
     case kStageTiming1Due:
     case kStageTiming2Due:
-      send_stage_timing(can, r.stage_counts, due == kStageTiming1Due ? 0 : 4);
+      send_stage_timing(can, timed_stages_, due == kStageTiming1Due ? 0 : 4);
       break;
     default:
       break;
   }
 }
-
-template void Telemetry::publish(uint64_t, hal::CanBus&, const TickRecord<float>&,
-                                 const DriveStatus&, const StateMachine&, const ExecutionStats&,
-                                 uint32_t) noexcept;
-template void Telemetry::publish(uint64_t, hal::CanBus&, const TickRecord<double>&,
-                                 const DriveStatus&, const StateMachine&, const ExecutionStats&,
-                                 uint32_t) noexcept;
 
 void Telemetry::send_stage_timing(hal::CanBus& can, const StageCounts& c, int first) noexcept {
   const float u = us_per_count_;

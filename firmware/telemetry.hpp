@@ -2,7 +2,8 @@
 /// What the drive sends on CAN, and when (docs/can/protocol.md): the heartbeat and the timing
 /// frame at 10 Hz, fast telemetry at a configurable 10..1000 Hz (three frames per sample, in
 /// one tick, the voltage frame last), and event frames for state changes, faults and command
-/// results. A tick sends the fast sample or one other cyclic frame, never both. The
+/// results. From 20 ticks per 100 ms, a tick sends the fast sample or one other cyclic frame
+/// (both only when a sample takes every tick). The
 /// version frame goes first at each start, before whatever frame the drive sends first, and
 /// then with every tenth heartbeat.
 /// Frames go to the HAL's non-blocking transmit queue; a full queue drops the frame and counts
@@ -54,9 +55,10 @@ class Telemetry {
   bool set_rate_Hz(int rate_Hz) noexcept;
   int rate_Hz() const noexcept { return rate_Hz_; }
 
-  /// A state_change frame for each new transition; then the fast sample's three frames if one
-  /// is due at tick k, or else the first of the other cyclic frames due by k and not yet sent
-  /// (one a tick: frames due together go out on the ticks that follow, in a fixed order).
+  /// A state_change frame for each new transition; the fast sample's three frames if one is
+  /// due at tick k; the first of the other cyclic frames due by k and not yet sent, unless a
+  /// sample went out (frames due together go out on the ticks that follow, in a fixed order;
+  /// all at once below 20 ticks per 100 ms).
   /// T: the drive's arithmetic (float and double are instantiated).
   template <typename T>
   void publish(uint64_t k, hal::CanBus& can, const TickRecord<T>& record, const DriveStatus& status,
@@ -88,11 +90,20 @@ class Telemetry {
   /// stage_timing_1 (`first` 0: the first four stages) or stage_timing_2 (4: the last four).
   void send_stage_timing(hal::CanBus& can, const StageCounts& counts, int first) noexcept;
 
+  /// One cyclic frame other than the fast sample's (`due`: one of the k...Due bits).
+  void send_cyclic(uint16_t due, uint64_t k, hal::CanBus& can, const DriveStatus& status,
+                   const StateMachine& machine, const ExecutionStats& execution,
+                   uint32_t budget_ns) noexcept;
+
   // The cyclic frames due and not yet sent, one bit each; publish() sends the lowest first.
   static constexpr uint16_t kHeartbeatDue = 1u << 0, kIdentifyProgressDue = 1u << 1,
                             kVersionDue = 1u << 2, kTimingDue = 1u << 3,
                             kStageTiming1Due = 1u << 4, kStageTiming2Due = 1u << 5;
   uint16_t pending_ = 0;
+  // Spread over ticks from 20 ticks per 100 ms (a 5 ms period): at least 10 ticks without a
+  // sample then, for the at most 3 frames due at once, before they fall due again.
+  static constexpr uint64_t kSpreadMinTicks = 20;
+  StageCounts timed_stages_{};  ///< the stage counts the stage-timing frames carry
 
   uint8_t node_id_;
   uint32_t period_ns_;

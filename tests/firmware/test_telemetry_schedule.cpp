@@ -3,6 +3,7 @@
 // of instructions; docs/performance-tick.md, "The whole tick, and the telemetry").
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <map>
 #include <vector>
 
@@ -58,28 +59,53 @@ Sent run(uint32_t period_ns, int rate_Hz, double seconds) {
   return r;
 }
 
+/// The fast samples in `seconds`: one every round(1 s / rate / period) ticks (at least one),
+/// from tick 1 (Telemetry::set_rate_Hz).
+double samples_in(uint32_t period_ns, int rate_Hz, double seconds) {
+  const double ticks_per_sample =
+      std::max(1.0, std::round(1e9 / rate_Hz / double(period_ns)));
+  return seconds * 1e9 / double(period_ns) / ticks_per_sample;
+}
+
+void expect_every_frame(const Sent& r, uint32_t period_ns, int rate_Hz) {
+  // 2 s: the 10 Hz frames 20 times; the version at the start and with the 10th and 20th
+  // heartbeat; the fast samples within one of their count.
+  EXPECT_EQ(r.count.at(MessageId::heartbeat), 20);
+  EXPECT_EQ(r.count.at(MessageId::timing), 20);
+  EXPECT_EQ(r.count.at(MessageId::stage_timing_1), 20);
+  EXPECT_EQ(r.count.at(MessageId::stage_timing_2), 20);
+  EXPECT_EQ(r.count.at(MessageId::version), 3);
+  const int samples = r.count.at(MessageId::telemetry_voltage);
+  EXPECT_NEAR(samples, samples_in(period_ns, rate_Hz, 2.0), 1.0);
+  EXPECT_EQ(r.count.at(MessageId::telemetry_speed_flux), samples);
+  EXPECT_EQ(r.count.at(MessageId::telemetry_current), samples);
+  EXPECT_FALSE(r.sample_split);
+  // The start: the version, then the heartbeat at tick 0, the first sample at tick 1.
+  EXPECT_EQ(r.first_tick.at(MessageId::heartbeat), 0u);
+  EXPECT_EQ(r.first_tick.at(MessageId::telemetry_voltage), 1u);
+}
+
 TEST(TelemetrySchedule, EachFrameAtItsRateAndOneCyclicFrameATick) {
-  for (const uint32_t period_ns : {100'000u, 50'000u}) {     // 10 and 20 kHz
+  for (const uint32_t period_ns : {100'000u, 50'000u, 1'000'000u}) {  // 10, 20 and 1 kHz
     for (const int rate_Hz : {10, 100, 333, 1000}) {
-      const Sent r = run(period_ns, rate_Hz, 2.0);
       SCOPED_TRACE(::testing::Message() << period_ns << " ns, " << rate_Hz << " Hz");
-      // 2 s: the 10 Hz frames 20 times; the version at the start and with every tenth
-      // heartbeat; the fast sample within one of 2 s x its rate (the rate rounds to whole ticks).
-      EXPECT_EQ(r.count.at(MessageId::heartbeat), 20);
-      EXPECT_EQ(r.count.at(MessageId::timing), 20);
-      EXPECT_EQ(r.count.at(MessageId::stage_timing_1), 20);
-      EXPECT_EQ(r.count.at(MessageId::stage_timing_2), 20);
-      EXPECT_EQ(r.count.at(MessageId::version), 3);  // at the start, with the 10th and 20th heartbeat
-      const int samples = r.count.at(MessageId::telemetry_voltage);
-      EXPECT_NEAR(samples, 2 * rate_Hz, 1);
-      EXPECT_EQ(r.count.at(MessageId::telemetry_speed_flux), samples);
-      EXPECT_EQ(r.count.at(MessageId::telemetry_current), samples);
-      EXPECT_FALSE(r.sample_split);
+      const Sent r = run(period_ns, rate_Hz, 2.0);
+      expect_every_frame(r, period_ns, rate_Hz);
       EXPECT_LE(r.most_other_frames_a_tick, 1);
-      EXPECT_LE(r.most_frames_a_tick, 3);
-      // The start: the version, then the heartbeat at tick 0, the first sample at tick 1.
-      EXPECT_EQ(r.first_tick.at(MessageId::heartbeat), 0u);
-      EXPECT_EQ(r.first_tick.at(MessageId::telemetry_voltage), 1u);
+      // A sample's three frames, and one more only where a sample takes every tick.
+      EXPECT_LE(r.most_frames_a_tick, samples_in(period_ns, rate_Hz, 1.0) * period_ns < 1e9
+                                          ? 3 : 4);
+    }
+  }
+}
+
+TEST(TelemetrySchedule, ASlowLoopSendsEveryFrameAtOnce) {
+  // 10 ms and 6.25 ms periods (10 and 16 ticks per 100 ms): too few ticks to spread the frames
+  // without losing one; every frame still goes out at its rate.
+  for (const uint32_t period_ns : {10'000'000u, 6'250'000u}) {
+    for (const int rate_Hz : {10, 50, 100}) {
+      SCOPED_TRACE(::testing::Message() << period_ns << " ns, " << rate_Hz << " Hz");
+      expect_every_frame(run(period_ns, rate_Hz, 2.0), period_ns, rate_Hz);
     }
   }
 }

@@ -96,7 +96,8 @@ int run_identify(const IdentifyOptions& o) {
   if (progress->step != 4) return fail("identify: " + progress_text(*progress), kExitRejected);
   // Done: the drive builds its model from the result and saves it outside the tick, then goes
   // idle; a record it refuses turns the step to failed (invalid_record). The progress frame
-  // follows the heartbeat of the same tick, so the first one after an idle heartbeat decides.
+  // follows its heartbeat (a tick or more later), so the first one after an idle heartbeat
+  // decides.
   bool idle = false, decided = false;
   receive_until(*bus, 5.0 * o.wait_s, [&](const hal::CanFrame& f) {
     if (const auto state = heartbeat_state(f, node)) {

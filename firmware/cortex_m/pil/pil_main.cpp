@@ -186,7 +186,8 @@ int run(const sim::EmbeddedScenario& s, const PilOptions& options, hal::ResetCau
   timer.stop();
   report.watchdog(feed_interval_max, kWatchdogTimeoutCounts);
   report.stages(stage_totals, timer.execution_clock_Hz());
-  return report.finish(drive, timer, observer, frames_sent, control.whole_tick(), control.longest_tick());
+  return report.finish(drive, timer, observer, frames_sent, control.whole_tick(),
+                       control.longest_tick());
 }
 
 }  // namespace
