@@ -179,14 +179,6 @@ class EncoderObserver {
     load_ = load_ + gain_load_ * innovation;
   }
 
-  /// What predict() would give, already computed by the exact model's predict() from this
-  /// observer's own state (VoltageFedModel: the same rows): the speed and the position, not
-  /// wrapped. Tick context (end of tick k).
-  void predicted(T omega_mech_rad_s, T theta_mech_rad) noexcept {
-    theta_ = wrap_2pi(theta_mech_rad);
-    omega_ = omega_mech_rad_s;
-  }
-
   /// predict() then correct().
   void update(const Vec2<T>& i_s_AB_A, const Vec2<T>& flux_r_AB_Wb, const Vec2<T>& v_AB_V,
               T theta_measured_rad) noexcept {

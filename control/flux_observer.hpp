@@ -17,9 +17,6 @@ class FluxObserver {
   const Vec2<T>& flux_r_AB_Wb() const noexcept { return flux_; }
   void reset(const Vec2<T>& flux_r_AB_Wb = Vec2<T>::Zero()) noexcept { flux_ = flux_r_AB_Wb; }
 
-  /// The advance below, already computed by the exact model's predict() from this estimate.
-  void predicted(const Vec2<T>& flux_r_AB_Wb) noexcept { flux_ = flux_r_AB_Wb; }
-
   /// Advances the estimate from step k to k+1 with I~_k and the applied v~_k.
   void update(const Vec2<T>& i_s_AB_A, const Vec2<T>& v_AB_V) noexcept {
     flux_ = a11_ * flux_ + a12_ * i_s_AB_A + b1_ * v_AB_V;

@@ -94,10 +94,11 @@ class ObserverEstimator final : public StateEstimator<T> {
   /// (its flux, current, speed, position and load) with the voltage that acts over [k, k+1]:
   /// the latency predictor's `next` (position not wrapped). The same rows, not computed twice.
   void advance_to(const control::RotorFrameState<T>& next) noexcept {
-    encoder_.predicted(next.omega_mech_rad_s, next.theta_mech_rad);
+    // The encoder observer's predict() keeps its load and wraps the position as reset() does.
+    encoder_.reset(next.theta_mech_rad, next.omega_mech_rad_s, encoder_.load_Nm());
     i_next_AB_A_ = next.i_s_AB_A;
     predicted_ = true;
-    flux_.predicted(next.flux_r_AB_Wb);
+    flux_.reset(next.flux_r_AB_Wb);
   }
 
   /// Takes over the state of the object this one replaces (the same motor but for its

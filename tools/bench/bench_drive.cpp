@@ -117,24 +117,22 @@ BENCHMARK_CAPTURE(BM_DriveSim, rk6_threaded/csv, "rk6", Output::csv, CsvFormatti
     ->Unit(benchmark::kMillisecond)->UseRealTime();
 
 /// The yardstick (tools/bench/reference_ifoc.hpp): a plain RK4 IFOC loop at 10 us on the
-/// realistic scenario's motor, bus, current limit, speed sine and load square, for as long.
+/// realistic scenario's motor, bus, current limit, flux, speed and load profiles, for as long.
 /// The ratios below give drive_sim's speed against it, measured in the same run.
 void BM_ReferenceIfoc(benchmark::State& bench) {
   const imd::sim::Scenario s = imd::sim::load_scenario(scenario_path("seed000_realistic.toml"));
   imd::bench::ReferenceIfocCase c;
   c.motor = s.motor;
-  c.flux_Wb = std::sqrt(0.2);  // the scenario's flux2_Wb2
+  c.flux_Wb = std::sqrt(s.flux2_Wb2);
   c.v_max_V = s.v_bus_V / std::sqrt(3.0);
   c.i_max_A = s.i_max_A;
-  c.speed_amplitude_rad_s = 100.0;  // the scenario's [reference.speed]
-  c.speed_frequency_Hz = 0.25;
-  c.load_high_Nm = 1.0;  // its [load]
-  c.load_period_s = 1.0;
   c.duration_s = s.duration_s;
   c.sample_period_s = s.sample_period_s;
   c.substeps = 10;
   for (auto _ : bench) {
-    const imd::bench::ReferenceIfocResult r = imd::bench::run_reference_ifoc(c);
+    const imd::bench::ReferenceIfocResult r = imd::bench::run_reference_ifoc(
+        c, [&s](double t_s) { return s.speed.at(t_s); },
+        [&s](double t_s) { return s.load.at(t_s); });
     // It must have driven the motor: a 10 Hz speed loop follows a 0.25 Hz sine of 100 rad/s
     // within a few rad/s (the load steps' dips included); a loop that did nothing would miss
     // by the sine's RMS, 71 rad/s.

@@ -24,8 +24,6 @@ struct ReferenceIfocCase {
   double flux_Wb = 0.0;        ///< psi*
   double v_max_V = 0.0;        ///< the voltage vector's limit
   double i_max_A = 0.0;        ///< the current command's limit
-  double speed_amplitude_rad_s = 0.0, speed_frequency_Hz = 0.0;  ///< a sine reference
-  double load_high_Nm = 0.0, load_period_s = 1.0;                 ///< a square load from 0
   double duration_s = 0.0;
   double sample_period_s = 1e-4;
   int substeps = 10;  ///< RK4 steps per period (10 us at 10 kHz)
@@ -36,7 +34,10 @@ struct ReferenceIfocResult {
   double speed_error_rms_rad_s = 0.0;  ///< over the second half
 };
 
-inline ReferenceIfocResult run_reference_ifoc(const ReferenceIfocCase& c) {
+/// `speed_at(t)`: the speed reference (rad/s) at time t; `load_at(t)`: the load torque (N m).
+template <typename SpeedAt, typename LoadAt>
+ReferenceIfocResult run_reference_ifoc(const ReferenceIfocCase& c, const SpeedAt& speed_at,
+                                       const LoadAt& load_at) {
   using State = Eigen::Matrix<double, 5, 1>;  // rotor flux (alpha, beta), current, speed
   const control::MotorParameters& m = c.motor;
   const double sigma = m.Ls_H - m.Lm_H * m.Lm_H / m.Lr_H;
@@ -57,10 +58,7 @@ inline ReferenceIfocResult run_reference_ifoc(const ReferenceIfocCase& c) {
   const long ticks = std::lround(c.duration_s / T);
   for (long k = 0; k < ticks; ++k) {
     const double t = double(k) * T;
-    const double w_ref =
-        c.speed_amplitude_rad_s * std::sin(2 * pi * c.speed_frequency_Hz * t);
-    const double load = std::fmod(t, c.load_period_s) < c.load_period_s / 2 ? 0.0
-                                                                             : c.load_high_Nm;
+    const double w_ref = speed_at(t), load = load_at(t);
     // Speed PI, its integrator held while the command is limited.
     const double e_w = w_ref - x(4);
     const double iq_free = kp_w * e_w + ki_w * (int_w + e_w * T);
