@@ -77,19 +77,28 @@ constexpr uint64_t field_mask(const Signal& s) noexcept {
   return s.length_bits >= 64 ? ~uint64_t(0) : (uint64_t(1) << s.length_bits) - 1;
 }
 
-/// The raw bits of a signal in their place in the payload read as one little-endian word.
+/// The raw bits of a signal in their place in the payload read as one little-endian word. The
+/// mask is taken in 32 bits (no signal is wider: frame_codec.hpp), which spares the MCU a
+/// 64-bit mask; only the shift into place is 64-bit.
 constexpr uint64_t placed(const Signal& s, int64_t raw) noexcept {
-  return (static_cast<uint64_t>(raw) & field_mask(s)) << s.start_bit;
+  const uint32_t mask = s.length_bits >= 32 ? ~uint32_t{0} : (uint32_t{1} << s.length_bits) - 1u;
+  return uint64_t{static_cast<uint32_t>(raw) & mask} << s.start_bit;
 }
 
-/// The payload as one little-endian word, and back.
+/// The payload as one little-endian word, and back: on a little-endian machine (the MCU, x86-64,
+/// AArch64) the bytes as they are, else byte by byte.
 constexpr uint64_t payload_word(const Payload& data) noexcept {
+  if constexpr (std::endian::native == std::endian::little) return std::bit_cast<uint64_t>(data);
   uint64_t bits = 0;
   for (int i = 0; i < 8; ++i) bits |= uint64_t(data[i]) << (8 * i);
   return bits;
 }
 constexpr void set_payload_word(Payload& data, uint64_t bits) noexcept {
-  for (int i = 0; i < 8; ++i) data[i] = static_cast<uint8_t>(bits >> (8 * i));
+  if constexpr (std::endian::native == std::endian::little) {
+    data = std::bit_cast<Payload>(bits);
+  } else {
+    for (int i = 0; i < 8; ++i) data[i] = static_cast<uint8_t>(bits >> (8 * i));
+  }
 }
 
 /// The raw bits of a signal (sign-extended for signed signals).
@@ -123,12 +132,39 @@ inline int64_t float_to_int64(float whole) noexcept {
   return int64_t{static_cast<int32_t>(high)} * (int64_t{1} << 32) + int64_t{low};
 }
 
+/// std::round (halves away from zero) without its library call on the MCU: below 2^23 the
+/// conversion to an integer truncates exactly, and the fraction x - trunc(x) is exact too.
+/// Larger magnitudes, infinities and NaN are returned as they are (they are whole or not
+/// numbers). A zero comes back as +0 where std::round keeps -0; the raw values are the same.
+inline float round_half_away(float x) noexcept {
+  if (!(std::fabs(x) < 8388608.0f)) return x;
+  const float whole = static_cast<float>(static_cast<int32_t>(x));
+  const float fraction = x - whole;
+  if (fraction >= 0.5f) return whole + 1.0f;
+  if (fraction <= -0.5f) return whole - 1.0f;
+  return whole;
+}
+
+/// raw_min() and raw_max() as floats, as a conversion of the 64-bit values gives them, from
+/// 32-bit integers: a 64-bit conversion is a library call on the MCU, and no signal is wider
+/// than 32 bits (frame_codec.hpp checks the tables).
+inline float raw_min_float(const Signal& s) noexcept {
+  return s.is_signed ? -static_cast<float>(uint32_t{1} << (s.length_bits - 1)) : 0.0f;
+}
+inline float raw_max_float(const Signal& s) noexcept {
+  const uint32_t max = s.is_signed         ? (uint32_t{1} << (s.length_bits - 1)) - 1u
+                       : s.length_bits >= 32 ? ~uint32_t{0}
+                                             : (uint32_t{1} << s.length_bits) - 1u;
+  return static_cast<float>(max);
+}
+
 /// The nearest raw value for a physical value, saturated to the signal's range. A NaN becomes
 /// raw_min: telemetry must never wrap around to a plausible value.
 inline int64_t to_raw(const Signal& s, float value) noexcept {
-  const float raw = std::round((value - s.offset) * float(s.scale_den) / float(s.scale_num));
-  if (!(raw >= float(s.raw_min()))) return s.raw_min();  // NaN and -Inf too
-  if (raw >= float(s.raw_max())) return s.raw_max();
+  const float raw =
+      round_half_away((value - s.offset) * float(s.scale_den) / float(s.scale_num));
+  if (!(raw >= raw_min_float(s))) return s.raw_min();  // NaN and -Inf too
+  if (raw >= raw_max_float(s)) return s.raw_max();
   return float_to_int64(raw);
 }
 
@@ -145,8 +181,9 @@ inline void set_physical(Payload& data, const Signal& s, float value) noexcept {
 /// Whether a physical value is representable without saturation (any float in a float signal).
 inline bool in_range(const Signal& s, float value) noexcept {
   if (s.is_float) return true;
-  const float raw = std::round((value - s.offset) * float(s.scale_den) / float(s.scale_num));
-  return raw >= float(s.raw_min()) && raw <= float(s.raw_max());
+  const float raw =
+      round_half_away((value - s.offset) * float(s.scale_den) / float(s.scale_num));
+  return raw >= raw_min_float(s) && raw <= raw_max_float(s);
 }
 
 }  // namespace imd::firmware::protocol

@@ -8,6 +8,16 @@
 
 namespace imd::firmware::protocol {
 
+// to_raw packs in single precision with 32-bit conversions (can_signal.hpp).
+static_assert([] {
+  for (const Message& m : kMessages) {
+    for (const Signal& s : m.signals) {
+      if (s.length_bits < 1 || s.length_bits > 32) return false;
+    }
+  }
+  return true;
+}(), "every signal is 1 to 32 bits long");
+
 /// A frame of message `id` for node `node_id` with `values` (physical, in signal order; missing
 /// values are 0, extra ones ignored). Saturates values outside a signal's range. Tick context.
 inline hal::CanFrame encode_frame(uint8_t node_id, MessageId id,

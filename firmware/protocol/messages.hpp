@@ -356,12 +356,21 @@ inline constexpr std::array<ValueName, kMessageCount> MessageIdNames::values = [
   return names;
 }();
 
+/// Each id's place in kMessages (kMessageCount: none), so that an id finds its message by one
+/// look-up: the tick encodes frames by id. Ids are below 32 (the CAN id's low five bits).
+inline constexpr std::array<uint8_t, 32> kMessageIndex = [] {
+  std::array<uint8_t, 32> index{};
+  index.fill(uint8_t(kMessageCount));
+  for (std::size_t i = 0; i < kMessageCount; ++i) index[uint8_t(kMessages[i].id)] = uint8_t(i);
+  return index;
+}();
+
 /// The definition of a message id, or nullptr.
 constexpr const Message* find_message(uint8_t message_id) noexcept {
-  for (const Message& m : kMessages) {
-    if (static_cast<uint8_t>(m.id) == message_id) return &m;
+  if (message_id >= kMessageIndex.size() || kMessageIndex[message_id] == kMessageCount) {
+    return nullptr;
   }
-  return nullptr;
+  return &kMessages[kMessageIndex[message_id]];
 }
 constexpr const Message& message(MessageId id) noexcept {
   return *find_message(uint8_t(id));

@@ -4,7 +4,9 @@
 #include <bit>
 #include <cmath>
 #include <limits>
+#include <random>
 #include <set>
+#include <vector>
 
 #include "firmware/protocol/commands.hpp"
 #include "firmware/protocol/e2e.hpp"
@@ -63,6 +65,74 @@ TEST(SignalPacking, FloatToInt64IsExactWithoutDouble) {
                             2147483648.0f, 4294967040.0f, 4294967296.0f, -4294967296.0f,
                             1099511627776.0f, -1099511627776.0f, 4.6116860e18f, -9.2233720e18f}) {
     EXPECT_EQ(protocol::float_to_int64(whole), static_cast<int64_t>(whole)) << whole;
+  }
+}
+
+// The packing rounds without the library's roundf: for every float it must give std::round's
+// value (a zero's sign aside, which no raw value keeps). Halves and their float neighbours at
+// every magnitude below 2^23, where the fraction is kept, then random bit patterns.
+TEST(SignalPacking, RoundHalfAwayIsStdRound) {
+  const auto same = [](float x) {
+    const float expected = std::round(x), got = round_half_away(x);
+    if (std::isnan(expected)) return std::isnan(got);
+    return got == expected;  // +0 == -0
+  };
+  for (const float x : {0.0f, -0.0f, 0.49999997f, -0.49999997f, 8388607.5f, -8388607.5f,
+                        8388608.0f, 16777217.0f, 3.0e38f, std::numeric_limits<float>::infinity(),
+                        -std::numeric_limits<float>::infinity(), std::nanf(""),
+                        std::numeric_limits<float>::denorm_min()}) {
+    EXPECT_TRUE(same(x)) << x;
+  }
+  for (int e = -24; e <= 23; ++e) {
+    for (const float whole : {0.0f, std::ldexp(1.0f, e), std::ldexp(1.5f, e)}) {
+      const float half = std::floor(whole) + 0.5f;
+      float x = half, y = half;
+      for (int ulp = 0; ulp < 4; ++ulp) {
+        EXPECT_TRUE(same(x) && same(-x) && same(y) && same(-y)) << x << " " << y;
+        x = std::nextafter(x, 0.0f);
+        y = std::nextafter(y, 1e30f);
+      }
+    }
+  }
+  std::mt19937 bits(20261127);
+  for (int i = 0; i < 2'000'000; ++i) {
+    const float x = std::bit_cast<float>(static_cast<uint32_t>(bits()));
+    ASSERT_TRUE(same(x)) << std::bit_cast<uint32_t>(x);
+  }
+}
+
+// to_raw compares with the signal's limits converted from 32-bit integers: the raw values must
+// be those of the 64-bit conversions and std::round, for every signal of the table, over its
+// whole physical range and past it (saturation), at its edges, and for NaN and infinities;
+// in_range likewise.
+TEST(SignalPacking, ToRawMatchesTheDoubleWidthReference) {
+  const auto reference = [](const Signal& s, float value) -> int64_t {
+    const float raw = std::round((value - s.offset) * float(s.scale_den) / float(s.scale_num));
+    if (!(raw >= float(s.raw_min()))) return s.raw_min();
+    if (raw >= float(s.raw_max())) return s.raw_max();
+    return static_cast<int64_t>(raw);
+  };
+  const auto reference_in_range = [](const Signal& s, float value) {
+    const float raw = std::round((value - s.offset) * float(s.scale_den) / float(s.scale_num));
+    return raw >= float(s.raw_min()) && raw <= float(s.raw_max());
+  };
+  std::mt19937 draw(7);
+  for (const Message& m : kMessages) {
+    for (const Signal& s : m.signals) {
+      if (s.is_float) continue;
+      const float lo = float(double(s.raw_min()) * s.scale() + s.offset);
+      const float hi = float(double(s.raw_max()) * s.scale() + s.offset);
+      std::uniform_real_distribution<float> value(lo - (hi - lo), hi + (hi - lo));
+      std::vector<float> values = {lo, hi, std::nextafter(lo, -1e30f), std::nextafter(hi, 1e30f),
+                                   std::nextafter(lo, hi), std::nextafter(hi, lo),
+                                   0.0f, std::nanf(""), std::numeric_limits<float>::infinity(),
+                                   -std::numeric_limits<float>::infinity()};
+      for (int i = 0; i < 20'000; ++i) values.push_back(value(draw));
+      for (const float v : values) {
+        ASSERT_EQ(to_raw(s, v), reference(s, v)) << m.name << "." << s.name << " at " << v;
+        ASSERT_EQ(in_range(s, v), reference_in_range(s, v)) << m.name << "." << s.name << v;
+      }
+    }
   }
 }
 
