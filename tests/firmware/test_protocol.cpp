@@ -6,6 +6,7 @@
 #include <limits>
 #include <random>
 #include <set>
+#include <string>
 #include <vector>
 
 #include "firmware/protocol/commands.hpp"
@@ -129,8 +130,9 @@ TEST(SignalPacking, ToRawMatchesTheDoubleWidthReference) {
                                    -std::numeric_limits<float>::infinity()};
       for (int i = 0; i < 20'000; ++i) values.push_back(value(draw));
       for (const float v : values) {
-        ASSERT_EQ(to_raw(s, v), reference(s, v)) << m.name << "." << s.name << " at " << v;
-        ASSERT_EQ(in_range(s, v), reference_in_range(s, v)) << m.name << "." << s.name << v;
+        const std::string where = std::string(m.name) + "." + s.name;
+        ASSERT_EQ(to_raw(s, v), reference(s, v)) << where << " at " << v;
+        ASSERT_EQ(in_range(s, v), reference_in_range(s, v)) << where << " at " << v;
       }
     }
   }
