@@ -367,10 +367,8 @@ inline constexpr std::array<uint8_t, 32> kMessageIndex = [] {
 
 /// The definition of a message id, or nullptr.
 constexpr const Message* find_message(uint8_t message_id) noexcept {
-  if (message_id >= kMessageIndex.size() || kMessageIndex[message_id] == kMessageCount) {
-    return nullptr;
-  }
-  return &kMessages[kMessageIndex[message_id]];
+  const bool known = message_id < kMessageIndex.size() && kMessageIndex[message_id] < kMessageCount;
+  return known ? &kMessages[kMessageIndex[message_id]] : nullptr;
 }
 constexpr const Message& message(MessageId id) noexcept {
   return *find_message(uint8_t(id));
