@@ -120,18 +120,6 @@ inline float get_physical(const Payload& data, const Signal& s) noexcept {
   return float(get_raw(data, s)) * float(s.scale_num) / float(s.scale_den) + s.offset;
 }
 
-/// A whole-valued float as an integer with single-precision conversions only: on the MCU a
-/// direct float-to-int64 cast is a library call that computes in double.
-inline int64_t float_to_int64(float whole) noexcept {
-  constexpr float k2p31 = 2147483648.0f, k2p32 = 4294967296.0f;
-  if (whole >= -k2p31 && whole < k2p31) return static_cast<int32_t>(whole);
-  if (whole >= 0.0f && whole < k2p32) return static_cast<int64_t>(static_cast<uint32_t>(whole));
-  // Beyond 2^32 a float's spacing is at least 512: both parts below are exact.
-  const float high = std::floor(whole / k2p32);
-  const auto low = static_cast<uint32_t>(whole - high * k2p32);
-  return int64_t{static_cast<int32_t>(high)} * (int64_t{1} << 32) + int64_t{low};
-}
-
 /// std::round (halves away from zero) without its library call on the MCU: below 2^23 the
 /// conversion to an integer truncates exactly, and the fraction x - trunc(x) is exact too.
 /// Larger magnitudes, infinities and NaN are returned as they are (they are whole or not
@@ -165,7 +153,9 @@ inline int64_t to_raw(const Signal& s, float value) noexcept {
       round_half_away((value - s.offset) * float(s.scale_den) / float(s.scale_num));
   if (!(raw >= raw_min_float(s))) return s.raw_min();  // NaN and -Inf too
   if (raw >= raw_max_float(s)) return s.raw_max();
-  return float_to_int64(raw);
+  // Inside the range, which 32 bits hold: one conversion (a 64-bit one is a library call in
+  // double on the MCU).
+  return s.is_signed ? int64_t{static_cast<int32_t>(raw)} : int64_t{static_cast<uint32_t>(raw)};
 }
 
 /// The raw value a physical value is sent as: a float's bits (NaN and infinities pass as they

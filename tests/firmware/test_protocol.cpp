@@ -59,16 +59,6 @@ TEST(SignalPacking, RoundTripsSignedValuesAndSaturates) {
   EXPECT_EQ(get_raw(data, kSpeedFluxSignals[1]), 700);
 }
 
-// The MCU converts raw values with single-precision instructions only: every whole-valued
-// float must come out exactly as the plain cast gives it, on both sides of 2^31 and 2^32.
-TEST(SignalPacking, FloatToInt64IsExactWithoutDouble) {
-  for (const float whole : {0.0f, 1.0f, -1.0f, 16777216.0f, -2147483648.0f, 2147483520.0f,
-                            2147483648.0f, 4294967040.0f, 4294967296.0f, -4294967296.0f,
-                            1099511627776.0f, -1099511627776.0f, 4.6116860e18f, -9.2233720e18f}) {
-    EXPECT_EQ(protocol::float_to_int64(whole), static_cast<int64_t>(whole)) << whole;
-  }
-}
-
 // The packing rounds without the library's roundf: for every float it must give std::round's
 // value (a zero's sign aside, which no raw value keeps). Halves and their float neighbours at
 // every magnitude below 2^23, where the fraction is kept, then random bit patterns.
