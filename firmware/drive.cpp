@@ -82,8 +82,7 @@ void Drive<T>::on_tick() noexcept {
       config_.brake_output_line >= 0 &&
       (!brake_line_level_ ||
        k < brake_released_tick_ + brake_release_ticks_);
-  Trip trip = protection_.check(m, e, supervised, u, out, u_written_V_,
-                                e.valid ? &model->checks : nullptr);
+  Trip trip = protection_.check(m, e, supervised, u, out, e.valid ? &model->checks : nullptr);
   // The power stage's own over-current trip already turned the outputs off: latch it.
   if (hw_.pwm.tripped()) trip.add(FaultCode::overcurrent, kHardwareTripDetail);
   clock.lap(Stage::protect);
@@ -257,12 +256,10 @@ inline void Drive<T>::actuate(uint64_t k, const Estimate<T>& e, const Modulation
   }
   if (trip.any() && supervisor_.latch(trip, k, motion)) {
     pwm_off();
-    u_written_V_ = Vec2::Zero();
   } else if (supervisor_.state() == DriveState::identifying ||
              (out.direct && supervisor_.modulating() && model != nullptr)) {
     hw_.pwm.set_duties(out.duty);  // the commissioning's or DC braking's own voltage
     hw_.pwm.enable();
-    u_written_V_ = out.u_alphabeta_V;
     if (supervisor_.state() != DriveState::identifying) {
       v_applied_V_ = out.v_acting_AB_V;
       u_applied_V = out.u_acting_alphabeta_V;
@@ -273,12 +270,10 @@ inline void Drive<T>::actuate(uint64_t k, const Estimate<T>& e, const Modulation
     } else {
       model->svpwm.write(out);
     }
-    u_written_V_ = out.u_alphabeta_V;
     v_applied_V_ = out.v_acting_AB_V;
     u_applied_V = out.u_acting_alphabeta_V;
-  } else {
-    if (hw_.pwm.enabled()) pwm_off();
-    u_written_V_ = Vec2::Zero();
+  } else if (hw_.pwm.enabled()) {
+    pwm_off();
   }
   if (!hw_.pwm.enabled()) v_applied_V_ = u_applied_V = Vec2::Zero();
   // The input acting over [k, k+1], for the observers: they advance after the PWM write.

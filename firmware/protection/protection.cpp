@@ -74,8 +74,8 @@ MotorChecks<T>::MotorChecks(const control::MotorParameters& motor,
       current_limit_A(T(config.current_margin * config.i_max_A)),
       per_Lm_H(T(1 / motor.Lm_H)),
       encoder(encoder_config<T>(motor, c, config, counts_per_rev)),
-      adc_stuck(config.protection.adc_stuck_ticks, config.sample_period_s,
-                control::derive_voltage_fed(motor).sigma_H, adc_A_per_code),
+      adc_stuck(config.protection.adc_stuck_ticks, adc_A_per_code,
+                control::derive_voltage_fed(motor).sigma_H, config.sample_period_s),
       phase_loss(phase_loss_config<T>(motor, config, adc_A_per_code)) {}
 
 template <typename T>
@@ -101,7 +101,7 @@ void Protection<T>::set_clock(uint32_t clock_Hz) noexcept {
 template <typename T>
 Trip Protection<T>::check(const Measurement<T>& m, const Estimate<T>& e, const SupervisedState& s,
                           const LawOutput<T>& law, const Modulation<T>& out,
-                          const control::Vec2<T>& u_last_V, MotorChecks<T>* motor) noexcept {
+                          MotorChecks<T>* motor) noexcept {
   Trip trip;
   if (s.restarted && motor != nullptr) motor->reset();
   if (!s.enable_input && s.modulating) trip.add(FaultCode::enable_input);
@@ -114,7 +114,7 @@ Trip Protection<T>::check(const Measurement<T>& m, const Estimate<T>& e, const S
     if (motor != nullptr) motor->idle();
     return trip;
   }
-  check_driving(m, e, s, u_last_V, *motor, trip);
+  check_driving(m, e, s, *motor, trip);
   if (trip.any()) return trip;
   if (s.magnetizing && s.magnetizing_ticks > magnetizing_timeout_ticks_) {
     trip.add(FaultCode::magnetizing_timeout);
@@ -155,10 +155,14 @@ inline void Protection<T>::check_sensed(const Measurement<T>& m, const Estimate<
 
 template <typename T>
 inline void Protection<T>::check_driving(const Measurement<T>& m, const Estimate<T>& e,
-                                         const SupervisedState& s, const control::Vec2<T>& u_last_V,
+                                         const SupervisedState& s,
                                          MotorChecks<T>& motor, Trip& trip) noexcept {
   if (!(m.v_bus_V >= bus_min_V_)) trip.add(FaultCode::bus_undervoltage);  // NaN too
-  if (config_.check_adc_stuck && motor.adc_stuck.stuck(m.phase_code, u_last_V)) {
+  // The model's prediction rests on the estimate, of no use while DC braking (the encoder
+  // failed): the stuck check then gathers no evidence, as the phase-loss check does not judge.
+  if (config_.check_adc_stuck &&
+      motor.adc_stuck.stuck(m.phase_code, m.i_abc_A, m.v_bus_V, e.i_predicted_alphabeta_A,
+                            e.current_predicted && !s.dc_braking)) {
     trip.add(FaultCode::adc_stuck);
   }
   // Codes that repeat exactly (a stuck ADC, before its own check has the evidence to say so)

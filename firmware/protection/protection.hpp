@@ -99,8 +99,7 @@ class Protection {
 
   /// `motor`: the motor model's checks, null without a motor record.
   Trip check(const Measurement<T>& m, const Estimate<T>& e, const SupervisedState& s,
-             const LawOutput<T>& law, const Modulation<T>& out, const control::Vec2<T>& u_last_V,
-             MotorChecks<T>* motor) noexcept;
+             const LawOutput<T>& law, const Modulation<T>& out, MotorChecks<T>* motor) noexcept;
   /// The tick took `exec_counts` of the execution clock: an overrun past the budget.
   Trip over_budget(uint32_t exec_counts) const noexcept;
   /// The budget in execution-clock counts (0: not checked), for a clock of `clock_Hz`.
@@ -111,9 +110,8 @@ class Protection {
                                            bool modulating, MotorChecks<T>* motor,
                                            Trip& trip) noexcept;
   [[gnu::always_inline]] void check_driving(const Measurement<T>& m, const Estimate<T>& e,
-                                            const SupervisedState& s,
-                                            const control::Vec2<T>& u_last_V,
-                                            MotorChecks<T>& motor, Trip& trip) noexcept;
+                                            const SupervisedState& s, MotorChecks<T>& motor,
+                                            Trip& trip) noexcept;
 
   ProtectionConfig config_;
   bool commands_over_can_;

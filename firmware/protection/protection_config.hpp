@@ -10,9 +10,10 @@
 
 namespace imd::firmware {
 
-/// The stuck-ADC check's window as a time: the evidence a window gathers is the voltage it
-/// sums times the period over sigma Ls, i.e. its volt-seconds, so a window of a fixed tick count
-/// would weaken with a shorter period. 2 ms is 20 ticks at 10 kHz.
+/// The stuck-ADC check's window as a time: the evidence a window gathers from a held voltage
+/// departure is the departure times half the window over sigma Ls (a tick's prediction moves
+/// by du period / sigma Ls, summed over half the window's ticks), i.e. volt-seconds, so a
+/// window of a fixed tick count would weaken with a shorter period. 2 ms is 20 ticks at 10 kHz.
 inline constexpr Real kAdcStuckWindow_s = Real(2e-3);
 
 /// kAdcStuckWindow_s in ticks of `period_s`, rounded, at least the check's minimum of 2.
@@ -40,8 +41,8 @@ struct ProtectionConfig {
   /// exceeds it. 0.75 leaves a quarter of the torque for the laws' current margins and the
   /// torque estimate's error (docs/safety.md).
   Real encoder_max_load_share = 0.75;
-  /// ADC stuck: ticks with identical phase codes while the applied voltage should have moved
-  /// the current by several codes. The default is adc_stuck_ticks_for(1e-4), 10 kHz's.
+  /// ADC stuck: ticks with identical phase codes while the motor model says the current moved
+  /// by several codes. The default is adc_stuck_ticks_for(1e-4), 10 kHz's.
   int adc_stuck_ticks = 20;
   /// Phase loss (firmware/protection/phase_loss_check.hpp): the board's worst voltage error
   /// (dead time, device drops, bus ripple) as a share of the phase voltage range V_bus/sqrt(3),

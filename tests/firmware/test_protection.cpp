@@ -21,8 +21,8 @@ struct MotorProtection {
   Protection<double> protection;
   MotorChecks<double> motor;
   Trip check(const Measurement<double>& m, const Estimate<double>& e, const SupervisedState& s,
-             const LawOutput<double>& law, const Modulation<double>& out, const Vec2& u_last_V) {
-    return protection.check(m, e, s, law, out, u_last_V, &motor);
+             const LawOutput<double>& law, const Modulation<double>& out) {
+    return protection.check(m, e, s, law, out, &motor);
   }
   void set_clock(uint32_t clock_Hz) { protection.set_clock(clock_Hz); }
   Trip over_budget(uint32_t counts) const { return protection.over_budget(counts); }
@@ -62,7 +62,7 @@ struct Bench {
 TEST(Protection, AHealthyTickTripsNothing) {
   Bench b;
   MotorProtection p = b.make();
-  EXPECT_FALSE(p.check(b.m, b.e, b.s, b.law, b.out, Vec2::Zero()).any());
+  EXPECT_FALSE(p.check(b.m, b.e, b.s, b.law, b.out).any());
 }
 
 TEST(Protection, TheFirstFaultIsNamedAndEveryFaultIsCounted) {
@@ -71,7 +71,7 @@ TEST(Protection, TheFirstFaultIsNamedAndEveryFaultIsCounted) {
   b.m.i_abc_A[1] = -9.5;  // phase b past the 9 A trip
   b.m.i_peak_A = 9.5;
   b.m.v_bus_V = 500.0;
-  const Trip t = p.check(b.m, b.e, b.s, b.law, b.out, Vec2::Zero());
+  const Trip t = p.check(b.m, b.e, b.s, b.law, b.out);
   EXPECT_EQ(t.first, FaultCode::overcurrent);
   EXPECT_EQ(t.detail, 1);  // the phase
   EXPECT_EQ(t.bits, (1u << unsigned(FaultCode::overcurrent)) |
@@ -82,7 +82,7 @@ TEST(Protection, ARailCodeIsOvercurrent) {
   Bench b;
   MotorProtection p = b.make();
   b.m.adc_saturated = true;
-  EXPECT_EQ(p.check(b.m, b.e, b.s, b.law, b.out, Vec2::Zero()).first, FaultCode::overcurrent);
+  EXPECT_EQ(p.check(b.m, b.e, b.s, b.law, b.out).first, FaultCode::overcurrent);
 }
 
 TEST(Protection, UndervoltageIsJudgedOnlyWhileDriving) {
@@ -90,11 +90,11 @@ TEST(Protection, UndervoltageIsJudgedOnlyWhileDriving) {
   MotorProtection p = b.make();
   b.m.v_bus_V = 150.0;
   b.s.modulating = false;
-  EXPECT_FALSE(p.check(b.m, b.e, b.s, b.law, b.out, Vec2::Zero()).any());
+  EXPECT_FALSE(p.check(b.m, b.e, b.s, b.law, b.out).any());
   b.s.modulating = true;
-  EXPECT_EQ(p.check(b.m, b.e, b.s, b.law, b.out, Vec2::Zero()).first, FaultCode::bus_undervoltage);
+  EXPECT_EQ(p.check(b.m, b.e, b.s, b.law, b.out).first, FaultCode::bus_undervoltage);
   b.m.v_bus_V = std::numeric_limits<double>::quiet_NaN();  // a NaN reading is no bus
-  EXPECT_EQ(p.check(b.m, b.e, b.s, b.law, b.out, Vec2::Zero()).first, FaultCode::bus_undervoltage);
+  EXPECT_EQ(p.check(b.m, b.e, b.s, b.law, b.out).first, FaultCode::bus_undervoltage);
 }
 
 TEST(Protection, TheEnableInputMattersOnlyWhileDriving) {
@@ -102,9 +102,9 @@ TEST(Protection, TheEnableInputMattersOnlyWhileDriving) {
   MotorProtection p = b.make();
   b.s.enable_input = false;
   b.s.modulating = false;
-  EXPECT_FALSE(p.check(b.m, b.e, b.s, b.law, b.out, Vec2::Zero()).any());
+  EXPECT_FALSE(p.check(b.m, b.e, b.s, b.law, b.out).any());
   b.s.modulating = true;
-  EXPECT_EQ(p.check(b.m, b.e, b.s, b.law, b.out, Vec2::Zero()).first, FaultCode::enable_input);
+  EXPECT_EQ(p.check(b.m, b.e, b.s, b.law, b.out).first, FaultCode::enable_input);
 }
 
 TEST(Protection, WhileCalibratingOnlyTheOffsetIsJudged) {
@@ -114,7 +114,7 @@ TEST(Protection, WhileCalibratingOnlyTheOffsetIsJudged) {
   b.m.i_peak_A = 100.0;  // not a measurement: ignored
   b.m.calibration = Calibration::offset_fault;
   b.m.offset_fault_phase = 2;
-  const Trip t = p.check(b.m, b.e, b.s, b.law, b.out, Vec2::Zero());
+  const Trip t = p.check(b.m, b.e, b.s, b.law, b.out);
   EXPECT_EQ(t.first, FaultCode::adc_offset);
   EXPECT_EQ(t.detail, 2);
   EXPECT_EQ(t.bits, 1u << unsigned(FaultCode::adc_offset));
@@ -125,9 +125,9 @@ TEST(Protection, MagnetizingTimesOutAfterItsTicks) {
   MotorProtection p = b.make();
   b.s.magnetizing = true;
   b.s.magnetizing_ticks = 100;
-  EXPECT_FALSE(p.check(b.m, b.e, b.s, b.law, b.out, Vec2::Zero()).any());
+  EXPECT_FALSE(p.check(b.m, b.e, b.s, b.law, b.out).any());
   b.s.magnetizing_ticks = 101;
-  EXPECT_EQ(p.check(b.m, b.e, b.s, b.law, b.out, Vec2::Zero()).first,
+  EXPECT_EQ(p.check(b.m, b.e, b.s, b.law, b.out).first,
             FaultCode::magnetizing_timeout);
 }
 
@@ -136,7 +136,7 @@ TEST(Protection, ALawWithoutSolutionAndANonFiniteOutputTrip) {
   MotorProtection p = b.make();
   b.law.ok = false;
   b.out.finite = false;
-  const Trip t = p.check(b.m, b.e, b.s, b.law, b.out, Vec2::Zero());
+  const Trip t = p.check(b.m, b.e, b.s, b.law, b.out);
   EXPECT_EQ(t.first, FaultCode::singular_control);
   EXPECT_EQ(t.bits, (1u << unsigned(FaultCode::singular_control)) |
                         (1u << unsigned(FaultCode::non_finite)));
@@ -148,10 +148,10 @@ TEST(Protection, TheCommandWatchdogNeedsCanCommands) {
   b.s.watchdog_armed = true;
   b.s.command_silence_ticks = 101;
   MotorProtection local = b.make();
-  EXPECT_FALSE(local.check(b.m, b.e, b.s, b.law, b.out, Vec2::Zero()).any());
+  EXPECT_FALSE(local.check(b.m, b.e, b.s, b.law, b.out).any());
   b.config.commands_over_can = true;
   MotorProtection commanded = b.make();
-  EXPECT_EQ(commanded.check(b.m, b.e, b.s, b.law, b.out, Vec2::Zero()).first,
+  EXPECT_EQ(commanded.check(b.m, b.e, b.s, b.law, b.out).first,
             FaultCode::command_timeout);
 }
 
@@ -173,10 +173,10 @@ TEST(Protection, TheSensorChecksCanBeSwitchedOff) {
   b.config.protection.check_encoder = false;
   MotorProtection p = b.make();
   b.m.encoder_delta_counts = 100000;  // an impossible jump
-  EXPECT_FALSE(p.check(b.m, b.e, b.s, b.law, b.out, Vec2::Zero()).any());
+  EXPECT_FALSE(p.check(b.m, b.e, b.s, b.law, b.out).any());
   b.config.protection.check_encoder = true;
   MotorProtection checked = b.make();
-  EXPECT_EQ(checked.check(b.m, b.e, b.s, b.law, b.out, Vec2::Zero()).first, FaultCode::encoder);
+  EXPECT_EQ(checked.check(b.m, b.e, b.s, b.law, b.out).first, FaultCode::encoder);
 }
 
 /// The phase-loss check's window on the paper motor: the check's own rule
@@ -188,10 +188,11 @@ int phase_loss_window_ticks(const DriveConfig& config) {
 
 // A converter that freezes: its codes repeat while the model predicts the current moving on.
 // The frozen reading also looks like phases that stopped carrying current. Here the codes
-// freeze as a phase-loss window opens, with phase a's current near zero, and the voltage holds
-// still for the stuck check's first window (no evidence: it restarts); the phase-loss window
-// would end first and blame phase a. It must wait while the codes repeat, so that the stuck
-// check names the fault once the voltage moves (50 V turning, in its second window).
+// freeze as a phase-loss window opens, with phase a's current near zero, and the model's
+// prediction holds still for the stuck check's first window (no evidence: it restarts); the
+// phase-loss window would end first and blame phase a. It must wait while the codes repeat, so
+// that the stuck check names the fault once the prediction moves (turning by 0.1 rad a tick,
+// judged a half window after its first window).
 TEST(Protection, FrozenCodesAreAStuckAdcNotALostPhase) {
   Bench b;
   MotorProtection p = b.make();
@@ -206,10 +207,15 @@ TEST(Protection, FrozenCodesAreAStuckAdcNotALostPhase) {
     return Vec2(amplitude_A * std::cos(angle), amplitude_A * std::sin(angle));
   };
   Trip first;
-  for (int tick = 0; tick < freeze + 2 * stuck_ticks && !first.any(); ++tick) {
+  int tick = 0;
+  for (; tick < freeze + 2 * stuck_ticks && !first.any(); ++tick) {
     const bool frozen = tick >= freeze;
     b.e.current_predicted = true;
-    b.e.i_predicted_alphabeta_A = current(tick);  // the model runs on
+    // The model: the measured current until the freeze, then still at the last one read for
+    // a window, then on.
+    const int still_until = freeze + stuck_ticks;
+    b.e.i_predicted_alphabeta_A = current(
+        tick < freeze ? tick : tick < still_until ? freeze - 1 : freeze + (tick - still_until));
     if (!frozen) {
       const control::PhaseValues<double> abc = control::inverse_clarke(current(tick));
       for (int j = 0; j < 3; ++j) {
@@ -217,21 +223,24 @@ TEST(Protection, FrozenCodesAreAStuckAdcNotALostPhase) {
         b.m.phase_code[std::size_t(j)] = uint16_t(2048 + std::lround(abc[j] / (10.0 / 2048)));
       }
     }
-    const double turn = tick < freeze + stuck_ticks ? 0.0 : 0.3 * (tick - freeze - stuck_ticks);
-    const Vec2 u_V(50.0 * std::cos(turn), 50.0 * std::sin(turn));
-    first = p.check(b.m, b.e, b.s, b.law, b.out, u_V);
+    first = p.check(b.m, b.e, b.s, b.law, b.out);
     if (!frozen) {
       ASSERT_FALSE(first.any()) << "healthy tick " << tick;
     }
   }
   ASSERT_TRUE(first.any()) << "the frozen converter went unnoticed";
   EXPECT_EQ(first.first, FaultCode::adc_stuck);
+  // The windows slide by halves of stuck_ticks / 2 repeated ticks from the freeze: the first
+  // judgement (at the end of the second half) sees two still halves; the next, a half later,
+  // the first turning half against a still one. tick counts the calls, one more.
+  EXPECT_EQ(tick, freeze + 3 * stuck_ticks / 2) << "a half after the first window";
 }
 
 // The other side of the wait: an open phase at standstill under a held voltage, read by a
-// quiet ADC, freezes the codes too, and gives the stuck check no evidence (a still voltage).
-// The phase-loss check waits one stuck-ADC window at most, then judges the frozen ticks: the
-// open phase is found within that window, the phase-loss window and the first skipped tick.
+// quiet ADC, freezes the codes too, and gives the stuck check no evidence (a still
+// prediction). The phase-loss check waits one stuck-ADC window at most, then judges the frozen
+// ticks: the open phase is found within that window, the phase-loss window and the first
+// skipped tick.
 TEST(Protection, AnOpenPhaseUnderAStillVoltageIsFoundThoughTheCodesRepeat) {
   Bench b;
   MotorProtection p = b.make();
@@ -242,11 +251,10 @@ TEST(Protection, AnOpenPhaseUnderAStillVoltageIsFoundThoughTheCodesRepeat) {
   b.m.i_abc_A[0] = 0.0, b.m.i_abc_A[1] = 2.6, b.m.i_abc_A[2] = -2.6;  // a open: b to c only
   b.m.phase_code = {2048, uint16_t(2048 + 532), uint16_t(2048 - 532)};  // 10 A / 2048 codes
   b.m.i_peak_A = 2.6;
-  const Vec2 u_V(150.0, 0.0);  // saturated and held
   Trip first;
   int tick = 0;
   for (; tick < 10 * (stuck_ticks + window_ticks) && !first.any(); ++tick) {
-    first = p.check(b.m, b.e, b.s, b.law, b.out, u_V);
+    first = p.check(b.m, b.e, b.s, b.law, b.out);
   }
   ASSERT_TRUE(first.any()) << "the open phase went unnoticed for " << tick << " ticks";
   EXPECT_EQ(first.first, FaultCode::phase_loss);

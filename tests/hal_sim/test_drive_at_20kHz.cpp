@@ -158,7 +158,7 @@ TEST(DriveAt20kHz, TimesGivenInSecondsDoubleInTicks) {
   const Scenario s20 = at_period("hal_sim/scenarios/seed000_realistic_20kHz.toml", k20kHz_s);
   const firmware::DriveConfig c10 = drive_config(s10), c20 = drive_config(s20);
   // The `limited` window (four speed-loop time constants, 40 ms) and the stuck-ADC window
-  // (2 ms of voltage evidence, firmware/protection/protection_config.hpp).
+  // (2 ms: its evidence is volt-seconds, firmware/protection/protection_config.hpp).
   EXPECT_EQ(firmware::limited_window_ticks(c10), 400u);
   EXPECT_EQ(firmware::limited_window_ticks(c20), 800u);
   EXPECT_EQ(c10.protection.adc_stuck_ticks, 20);
