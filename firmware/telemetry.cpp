@@ -23,8 +23,7 @@ constexpr const protocol::Signal& kGitHash = signal_of(MessageId::version, "git_
 static_assert(imd::version::kPatch <= signal_of(MessageId::version, "firmware_patch").raw_max(),
               "the version frame carries the patch number in 7 bits");
 
-Telemetry::Telemetry(uint8_t node_id, uint32_t period_ns, int rate_Hz,
-                     float ns_per_count) noexcept
+Telemetry::Telemetry(uint8_t node_id, uint32_t period_ns, int rate_Hz, float ns_per_count) noexcept
     : node_id_(node_id),
       period_ns_(period_ns),
       us_per_count_(ns_per_count * 1e-3f),
@@ -107,10 +106,9 @@ void Telemetry::publish(uint64_t k, hal::CanBus& can, const TickRecord<T>& r,
     send(can, encode_frame(node_id_, MessageId::telemetry_speed_flux,
                            {float(r.omega_est_rad_s), float(r.omega_ref_rad_s),
                             float(r.controlled_flux2_Wb2), float(r.controlled_flux2_ref_Wb2)}));
-    send(can,
-         encode_frame(node_id_, MessageId::telemetry_current,
-                      {float(r.i_s_est_AB_A.x()), float(r.i_s_est_AB_A.y()), float(r.load_est_Nm),
-                       float(r.v_bus_V)}));
+    send(can, encode_frame(node_id_, MessageId::telemetry_current,
+                           {float(r.i_s_est_AB_A.x()), float(r.i_s_est_AB_A.y()),
+                            float(r.load_est_Nm), float(r.v_bus_V)}));
     send(can, encode_frame(node_id_, MessageId::telemetry_voltage,
                            {float(r.u_alphabeta_V.x()), float(r.u_alphabeta_V.y()),
                             float(sample_count_++), float(r.rr_scale)}));
@@ -145,7 +143,10 @@ void Telemetry::send_cyclic(uint16_t due, uint64_t k, hal::CanBus& can, const Dr
       send_heartbeat(can, status, machine);
       break;
     case kIdentifyProgressDue: {
-      const float seconds = float(k - status.identify_start_tick) * float(period_ns_) * 1e-9f;
+      // In 32 bits (a 64-bit conversion is a library call on the MCU): 2^32 ticks are days.
+      const uint64_t ticks = k - status.identify_start_tick;
+      const float seconds = float(static_cast<uint32_t>(std::min<uint64_t>(ticks, UINT32_MAX))) *
+                            float(period_ns_) * 1e-9f;
       send(can, encode_frame(node_id_, MessageId::identify_progress,
                              {float(status.identify_step), status.identify_fraction,
                               float(status.identify_failure), seconds}));
@@ -155,10 +156,11 @@ void Telemetry::send_cyclic(uint16_t due, uint64_t k, hal::CanBus& can, const Dr
       send_version(can);
       break;
     case kTimingDue:
-      send(can, encode_frame(node_id_, MessageId::timing,
-                             {execution.mean_us(), float(execution.max_ns) * 1e-3f,
-                              float(std::min<uint64_t>(execution.overruns, 0xFFFF)),
-                              float(budget_ns) * 1e-3f}));
+      send(can, encode_frame(
+                    node_id_, MessageId::timing,
+                    {execution.mean_us(), float(execution.max_ns) * 1e-3f,
+                     float(static_cast<uint32_t>(std::min<uint64_t>(execution.overruns, 0xFFFF))),
+                     float(budget_ns) * 1e-3f}));
       break;
     case kStageTiming1Due:
     case kStageTiming2Due:
@@ -171,10 +173,10 @@ void Telemetry::send_cyclic(uint16_t due, uint64_t k, hal::CanBus& can, const Dr
 
 void Telemetry::send_stage_timing(hal::CanBus& can, const StageCounts& c, int first) noexcept {
   const float u = us_per_count_;
-  send(can, encode_frame(node_id_,
-                         first == 0 ? MessageId::stage_timing_1 : MessageId::stage_timing_2,
-                         {float(c[first]) * u, float(c[first + 1]) * u, float(c[first + 2]) * u,
-                          float(c[first + 3]) * u}));
+  send(can,
+       encode_frame(node_id_, first == 0 ? MessageId::stage_timing_1 : MessageId::stage_timing_2,
+                    {float(c[first]) * u, float(c[first + 1]) * u, float(c[first + 2]) * u,
+                     float(c[first + 3]) * u}));
 }
 
 void Telemetry::final_heartbeat(hal::CanBus& can, const DriveStatus& status,
@@ -204,9 +206,8 @@ void Telemetry::send_heartbeat(hal::CanBus& can, const DriveStatus& status,
       node_id_, MessageId::heartbeat,
       {float(status.state), float(status.first_fault), float(heartbeat_count_++),
        float(status.command_counter), float(status.controller), status.can_bus_off ? 1.0f : 0.0f,
-       float(status.rejected_commands & 0x3F), float(status.limited),
-       float(machine.count() & 0xFF), float(status.stop), status.brake_engaged ? 1.0f : 0.0f,
-       float(status.reset_cause)});
+       float(status.rejected_commands & 0x3F), float(status.limited), float(machine.count() & 0xFF),
+       float(status.stop), status.brake_engaged ? 1.0f : 0.0f, float(status.reset_cause)});
   protocol::set_fault_bits(frame.data, protocol::kHeartbeatFaultWordBit, status.fault_bits);
   send(can, frame);
 }

@@ -123,8 +123,8 @@ class AdcStuckCheck {
  private:
   int stuck_ticks_, half_ticks_;
   T evidence_needed_A_;
-  T band_A_per_V_;  ///< the zero-crossing band per volt of bus
-  int half_count_ = 0;         ///< ticks into the current half
+  T band_A_per_V_;              ///< the zero-crossing band per volt of bus
+  int half_count_ = 0;          ///< ticks into the current half
   bool judged_halves_ = false;  ///< a complete half precedes the current one
   bool started_ = false;
   int repeated_run_ = 0;  ///< ticks the codes have repeated in a row, up to stuck_ticks_

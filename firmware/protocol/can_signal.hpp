@@ -116,8 +116,13 @@ constexpr void set_raw(Payload& data, const Signal& s, int64_t raw) noexcept {
 
 /// The physical value of a signal, in single precision (what the MCU decodes with).
 inline float get_physical(const Payload& data, const Signal& s) noexcept {
-  if (s.is_float) return std::bit_cast<float>(static_cast<uint32_t>(get_raw(data, s)));
-  return float(get_raw(data, s)) * float(s.scale_num) / float(s.scale_den) + s.offset;
+  const int64_t raw = get_raw(data, s);
+  if (s.is_float) return std::bit_cast<float>(static_cast<uint32_t>(raw));
+  // No signal is wider than 32 bits (frame_codec.hpp): one 32-bit conversion, not a 64-bit
+  // one (a library call on the MCU).
+  const float value =
+      s.is_signed ? float(static_cast<int32_t>(raw)) : float(static_cast<uint32_t>(raw));
+  return value * float(s.scale_num) / float(s.scale_den) + s.offset;
 }
 
 /// std::round (halves away from zero) without its library call on the MCU: below 2^23 the
@@ -140,7 +145,7 @@ inline float raw_min_float(const Signal& s) noexcept {
   return s.is_signed ? -static_cast<float>(uint32_t{1} << (s.length_bits - 1)) : 0.0f;
 }
 inline float raw_max_float(const Signal& s) noexcept {
-  const uint32_t max = s.is_signed         ? (uint32_t{1} << (s.length_bits - 1)) - 1u
+  const uint32_t max = s.is_signed           ? (uint32_t{1} << (s.length_bits - 1)) - 1u
                        : s.length_bits >= 32 ? ~uint32_t{0}
                                              : (uint32_t{1} << s.length_bits) - 1u;
   return static_cast<float>(max);
@@ -149,8 +154,7 @@ inline float raw_max_float(const Signal& s) noexcept {
 /// The nearest raw value for a physical value, saturated to the signal's range. A NaN becomes
 /// raw_min: telemetry must never wrap around to a plausible value.
 inline int64_t to_raw(const Signal& s, float value) noexcept {
-  const float raw =
-      round_half_away((value - s.offset) * float(s.scale_den) / float(s.scale_num));
+  const float raw = round_half_away((value - s.offset) * float(s.scale_den) / float(s.scale_num));
   if (!(raw >= raw_min_float(s))) return s.raw_min();  // NaN and -Inf too
   if (raw >= raw_max_float(s)) return s.raw_max();
   // Inside the range, which 32 bits hold: one conversion (a 64-bit one is a library call in
@@ -171,8 +175,7 @@ inline void set_physical(Payload& data, const Signal& s, float value) noexcept {
 /// Whether a physical value is representable without saturation (any float in a float signal).
 inline bool in_range(const Signal& s, float value) noexcept {
   if (s.is_float) return true;
-  const float raw =
-      round_half_away((value - s.offset) * float(s.scale_den) / float(s.scale_num));
+  const float raw = round_half_away((value - s.offset) * float(s.scale_den) / float(s.scale_num));
   return raw >= raw_min_float(s) && raw <= raw_max_float(s);
 }
 

@@ -5,6 +5,7 @@
 #include <numbers>
 
 #include "control/svpwm.hpp"
+#include "hal/u64_to_real.hpp"
 
 namespace imd::firmware {
 
@@ -62,7 +63,9 @@ Calibration BoardSensing<T>::calibrate(const hal::AdcSample& sample, Measurement
   if (++calibration_count_ < calibration_ticks_) return Calibration::running;
   was_calibrating_ = false;
   for (int phase = 0; phase < 3; ++phase) {
-    offset_code_[phase] = T(calibration_sum_[phase]) / T(calibration_count_);
+    // Not a 64-bit conversion (a library call on the MCU); the sum of codes is not negative.
+    offset_code_[phase] =
+        hal::u64_to_real<T>(static_cast<uint64_t>(calibration_sum_[phase])) / T(calibration_count_);
     const T offset_A = (offset_code_[phase] - mid_code_) * A_per_code_;
     if (std::abs(offset_A) > offset_limit_A_) {
       m.offset_fault_phase = uint8_t(phase);
