@@ -16,10 +16,13 @@ constexpr uint8_t kNoIdentification = 6;  // kIdentifyStepValues' "none"
 
 using protocol::signal_of;
 // Counts above 2^24 do not fit a float's mantissa: these are packed as raw bits.
-constexpr const protocol::Signal& kStateChangeTime = signal_of(MessageId::state_change, "time_ms");
-constexpr const protocol::Signal& kFirstFaultTime =
-    signal_of(MessageId::fault_report, "first_fault_time_ms");
-constexpr const protocol::Signal& kGitHash = signal_of(MessageId::version, "git_hash");
+// Copies without their names (protocol/runtime_messages.hpp): the named tables stay out of the
+// image.
+constexpr protocol::Signal kStateChangeTime =
+    protocol::runtime_signal_of(MessageId::state_change, "time_ms");
+constexpr protocol::Signal kFirstFaultTime =
+    protocol::runtime_signal_of(MessageId::fault_report, "first_fault_time_ms");
+constexpr protocol::Signal kGitHash = protocol::runtime_signal_of(MessageId::version, "git_hash");
 static_assert(imd::version::kPatch <= signal_of(MessageId::version, "firmware_patch").raw_max(),
               "the version frame carries the patch number in 7 bits");
 

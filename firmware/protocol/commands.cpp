@@ -1,6 +1,7 @@
 #include "firmware/protocol/commands.hpp"
 
 #include "firmware/protocol/e2e.hpp"
+#include "firmware/protocol/runtime_messages.hpp"
 
 namespace imd::firmware::protocol {
 namespace {
@@ -14,7 +15,7 @@ bool names_a_law(float value) noexcept {
 }
 
 constexpr const Signal& payload_signal(MessageId id) noexcept {
-  return message(id).signals[2];
+  return runtime_message(id).signals[2];
 }
 
 }  // namespace
@@ -56,7 +57,7 @@ Decoded CommandDecoder::decode(const hal::CanFrame& frame) noexcept {
   Decoded d;
   if (frame.id > 0x7FF || node_of(frame.id) != node_id_) return d;
   d.message_id = message_of(frame.id);
-  const Message* m = find_message(d.message_id);
+  const Message* m = find_runtime_message(d.message_id);
   if (m == nullptr || m->direction != Direction::host_to_drive) {
     // The drive's own telemetry echoed on the bus is not a command; an unknown id is.
     if (m != nullptr) return d;
@@ -128,7 +129,7 @@ Decoded CommandDecoder::decode(const hal::CanFrame& frame) noexcept {
     case MessageId::parameter_access: {
       // The field and the value are the application's to judge (it answers with a reason);
       // an operation the protocol does not define is a malformed frame.
-      const Message& pa = message(MessageId::parameter_access);
+      const Message& pa = runtime_message(MessageId::parameter_access);
       c.kind = CommandKind::parameter_access;
       const int64_t op = get_raw(frame.data, pa.signals[2]);
       if (op >= kParameterOpCount) return reject(d, CommandResult::out_of_range);
@@ -149,7 +150,7 @@ Decoded CommandDecoder::decode(const hal::CanFrame& frame) noexcept {
 
 hal::CanFrame CommandEncoder::encode(const Command& command) noexcept {
   const MessageId id = message_for(command.kind);
-  const Message& m = message(id);
+  const Message& m = runtime_message(id);
   hal::CanFrame frame;
   frame.id = can_id(node_id_, id);
   frame.length = m.length;

@@ -4,6 +4,7 @@
 #include <initializer_list>
 
 #include "firmware/protocol/messages.hpp"
+#include "firmware/protocol/runtime_messages.hpp"
 #include "hal/can_bus.hpp"
 
 namespace imd::firmware::protocol {
@@ -22,7 +23,7 @@ static_assert([] {
 /// values are 0, extra ones ignored). Saturates values outside a signal's range. Tick context.
 inline hal::CanFrame encode_frame(uint8_t node_id, MessageId id,
                                   std::initializer_list<float> values) noexcept {
-  const Message& m = message(id);
+  const Message& m = runtime_message(id);
   hal::CanFrame frame;
   frame.id = can_id(node_id, id);
   frame.length = m.length;

@@ -2,6 +2,7 @@
 
 #include "firmware/protocol/can_signal.hpp"
 #include "firmware/protocol/messages.hpp"
+#include "firmware/protocol/runtime_messages.hpp"
 #include "hal/cortex_m/stack_usage.hpp"
 #include "hal/cortex_m/text_line.hpp"
 
@@ -31,9 +32,9 @@ void PilReport::recompute(const RecomputeCost& cost) noexcept {
 }
 
 void PilReport::first_heartbeat(const hal::CanFrame& frame) noexcept {
-  const protocol::Message& m = protocol::message(protocol::MessageId::heartbeat);
-  const int index = protocol::find_signal(m, "reset_cause");
-  const auto raw = protocol::get_raw(frame.data, m.signals[std::size_t(index)]);
+  constexpr protocol::Signal kResetCause =
+      protocol::runtime_signal_of(protocol::MessageId::heartbeat, "reset_cause");
+  const auto raw = protocol::get_raw(frame.data, kResetCause);
   TextLine line;
   line << "pil first_heartbeat reset_cause "
        << protocol::kResetCauseValues[static_cast<std::size_t>(raw) & 3].name << "\n";
