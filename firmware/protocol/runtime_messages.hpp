@@ -1,9 +1,10 @@
 #pragma once
 /// The message tables the firmware reads at run time (packing telemetry, decoding commands).
 /// With the documentation text (host builds) they are kMessages itself. Without it (the
-/// bare-metal images) they are copies of kMessages whose signals have no name and no value
-/// table: the names are read at compile time only (signal_of, find_signal), so the named
-/// tables are never emitted and their strings stay out of the image. Tick context.
+/// bare-metal images) they are copies of kMessages without the message's name, and whose
+/// signals have no name and no value table: the names are read at compile time only (signal_of,
+/// find_signal), so the named tables are never emitted and their strings stay out of the image.
+/// Tick context.
 #include <array>
 #include <cstddef>
 #include <cstdint>
@@ -41,7 +42,7 @@ inline constexpr auto kNamelessSignals = [] {
 template <std::size_t... I>
 constexpr std::array<Message, kMessageCount> nameless_messages(std::index_sequence<I...>) noexcept {
   std::array<Message, kMessageCount> messages{kMessages[I]...};
-  ((messages[I].signals = kNamelessSignals<I>), ...);
+  ((messages[I].signals = kNamelessSignals<I>, messages[I].name = nullptr), ...);
   return messages;
 }
 inline constexpr std::array<Message, kMessageCount> kNamelessMessages =
