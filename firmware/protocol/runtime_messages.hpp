@@ -1,10 +1,10 @@
 #pragma once
 /// The message tables the firmware reads at run time (packing telemetry, decoding commands).
 /// With the documentation text (host builds) they are kMessages itself. Without it (the
-/// bare-metal images) they are copies of kMessages without the message's name, and whose
-/// signals have no name and no value table: the names are read at compile time only (signal_of,
-/// find_signal), so the named tables are never emitted and their strings stay out of the image.
-/// Tick context.
+/// bare-metal images) they are copies of kMessages without the messages' names and the fault
+/// bits, whose signals have no name and no value table: the names are read at compile time
+/// only (signal_of, find_signal), so the named tables are never emitted and their strings stay
+/// out of the image. Tick context.
 #include <array>
 #include <cstddef>
 #include <cstdint>
@@ -31,9 +31,17 @@ constexpr Signal without_name(const Signal& s) noexcept {
 }
 
 namespace detail {
+/// A message's signals before its fault bits (they come last, and the firmware packs them as one
+/// fault word: fault_bits.hpp).
+constexpr std::size_t own_signal_count(const Message& m) noexcept {
+  std::size_t n = 0;
+  while (n < m.signals.size() && fault_code_of(m.signals[n]) < 0) ++n;
+  return n;
+}
+
 template <std::size_t I>
 inline constexpr auto kNamelessSignals = [] {
-  std::array<Signal, kMessages[I].signals.size()> signals{};
+  std::array<Signal, own_signal_count(kMessages[I])> signals{};
   for (std::size_t j = 0; j < signals.size(); ++j)
     signals[j] = without_name(kMessages[I].signals[j]);
   return signals;
@@ -50,7 +58,7 @@ inline constexpr std::array<Message, kMessageCount> kNamelessMessages =
 }  // namespace detail
 
 /// The copies pack and unpack as the named tables do: every field but the name and the value
-/// table is the same, in the same order.
+/// table is the same, in the same order, and all the signals they leave out are fault bits.
 constexpr bool same_packing(const Signal& a, const Signal& b) noexcept {
   return a.start_bit == b.start_bit && a.length_bits == b.length_bits &&
          a.is_signed == b.is_signed && a.scale_num == b.scale_num && a.scale_den == b.scale_den &&
@@ -63,11 +71,13 @@ static_assert(
         const Message& named = kMessages[i];
         const Message& copy = detail::kNamelessMessages[i];
         if (copy.id != named.id || copy.length != named.length ||
-            copy.direction != named.direction || copy.signals.size() != named.signals.size()) {
+            copy.direction != named.direction || copy.signals.size() > named.signals.size()) {
           return false;
         }
         for (std::size_t j = 0; j < named.signals.size(); ++j) {
-          if (!same_packing(copy.signals[j], named.signals[j]) || copy.signals[j].name != nullptr) {
+          if (j >= copy.signals.size() ? fault_code_of(named.signals[j]) < 0
+                                       : !same_packing(copy.signals[j], named.signals[j]) ||
+                                             copy.signals[j].name != nullptr) {
             return false;
           }
         }
