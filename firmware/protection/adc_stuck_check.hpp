@@ -78,7 +78,10 @@ class AdcStuckCheck {
       later_sum_A_ = control::Vec2<T>::Zero();
       return false;
     }
-    later_sum_A_ += i_predicted_A;
+    // Summed as departures from the run's first prediction: small numbers, so that the two
+    // halves' difference keeps its precision in float over a long window too.
+    if (half_count_ == 0 && !judged_halves_) origin_A_ = i_predicted_A;
+    later_sum_A_ += i_predicted_A - origin_A_;
     if (++half_count_ < half_ticks_) return false;
     half_count_ = 0;
     control::Vec2<T> evidence_A = later_sum_A_ - reference_sum_A_;
@@ -116,6 +119,7 @@ class AdcStuckCheck {
     started_ = old.started_;
     repeated_run_ = old.repeated_run_;
     last_codes_ = old.last_codes_;
+    origin_A_ = old.origin_A_;
     reference_sum_A_ = old.reference_sum_A_;
     later_sum_A_ = old.later_sum_A_;
   }
@@ -129,6 +133,7 @@ class AdcStuckCheck {
   bool started_ = false;
   int repeated_run_ = 0;  ///< ticks the codes have repeated in a row, up to stuck_ticks_
   std::array<uint16_t, 3> last_codes_{};
+  control::Vec2<T> origin_A_ = control::Vec2<T>::Zero();         ///< the run's first prediction
   control::Vec2<T> reference_sum_A_ = control::Vec2<T>::Zero();  ///< the last complete half's
   control::Vec2<T> later_sum_A_ = control::Vec2<T>::Zero();      ///< the current half's
 };
