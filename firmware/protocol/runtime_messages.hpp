@@ -18,6 +18,7 @@ namespace imd::firmware::protocol {
 constexpr const Message* find_runtime_message(uint8_t message_id) noexcept {
   return find_message(message_id);
 }
+/// With the documentation text the run-time tables are the named ones: a copy keeps all.
 constexpr Signal without_name(const Signal& s) noexcept {
   return s;
 }
