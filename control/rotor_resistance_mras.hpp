@@ -13,8 +13,8 @@
 /// and near the true value its relative error decays at the rate 2 x^2/(1 + x^2) / tau_c
 /// (docs/robustness.md). At no load the slip is zero, x = 0, Q^ does not depend on rho^, and
 /// the estimate is frozen: below |x| = min_slip_tangent, and below min_frequency_rad_s of the
-/// stator frequency (Q is then too small against the voltage's errors). Tick context except
-/// construction.
+/// stator frequency, now or in the filtered powers (Q is then too small against the voltage's
+/// errors). Tick context except construction.
 #include <algorithm>
 #include <cmath>
 
@@ -100,8 +100,14 @@ class RotorResistanceMras {
     across_ += filter_ * (cross(flux_AB_Wb_, i_AB_A) - across_);
     tangent_ = along_ > T(0) ? across_ / along_ : T(0);
     const T omega_e = p_ * omega_mech_rad_s + tangent_ * Rr_Ohm_ * inv_Lr_;
+    // The filtered powers must also have been drawn above that frequency: in steady state
+    // q_adapt_ = (Lm/Lr) w_e i.Psi^, and after a reversal the filters still hold the powers of
+    // the slower frequencies of the last ~tau_r, near zero, whose ratio the voltage's errors
+    // decide (docs/robustness.md, "Near a reversal").
+    const T q_floor = min_frequency_ * Lm_over_Lr_ * along_;
     adapting_ = adapt && along_ > T(0) && std::abs(tangent_) >= min_tangent_ &&
-                std::abs(omega_e) >= min_frequency_ && q_adapt_ * omega_e > T(0);
+                std::abs(omega_e) >= min_frequency_ && q_adapt_ * omega_e > T(0) &&
+                std::abs(q_adapt_) >= q_floor;
     const T relative = (q_ref_ - q_adapt_) / q_adapt_;
     if (adapting_ && std::isfinite(relative)) {
       // The relative step, bounded: one tick moves the estimate by at most gain x 100 %. The
