@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <numbers>
 #include <string>
 
@@ -25,7 +26,7 @@ namespace {
 
 struct Board {
   const char* file;
-  const char* laws[2];  ///< nullptr: none
+  const char* laws[2];
 };
 
 const Board kBoards[] = {
