@@ -45,19 +45,20 @@ class FluxOuterLoop {
     using std::sqrt;
     const T error = flux2_ref_Wb2 - flux2_Wb2;
     const T v2_linear = (T(1) - e_) * flux2_ref_Wb2 + kp_ * error + integral_;
-    integral_ += ki_ * error;
     const T flux2 = flux2_Wb2 > T(0) ? flux2_Wb2 : T(0);
     const T floor = e_ * e_ * flux2;
     const T intended = e_ * flux2 + v2_linear;  // F(k+1) of the linear design
+    // At the floor the flux shrinks as fast as it can: integrating a negative error there
+    // only winds the integrator down, and the flux stays at the floor long after the
+    // reference is above it again (anti-windup).
+    if (intended > floor || error > T(0)) integral_ += ki_ * error;
     return sqrt(flux2) * sqrt(intended > floor ? intended : floor) - e_ * flux2;
   }
   void reset() noexcept { integral_ = T(0); }
 
   /// Takes over the state of the object this one replaces (the same motor but for its
   /// rotor resistance): the tick changes coefficients and keeps state (docs/robustness.md).
-  void continue_from(const FluxOuterLoop& old) noexcept {
-    integral_ = old.integral_;
-  }
+  void continue_from(const FluxOuterLoop& old) noexcept { integral_ = old.integral_; }
 
  private:
   T e_, kp_, ki_;

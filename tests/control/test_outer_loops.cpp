@@ -91,6 +91,29 @@ TEST(FluxOuterLoop, StepRealisesTheDesignedClosedLoop) {
   EXPECT_LT(std::abs(error.back()), 0.03 * 0.1);  // decayed by (1 + 39 * 0.1) z^39 ~ 0.1
 }
 
+TEST(FluxOuterLoop, DoesNotWindUpWhileTheFluxShrinksAtItsFastest) {
+  // The reference drops from 1 to 0.01 Wb^2: the loop asks for the fastest decay, the floor
+  // e^2 F (v2 = 0, no current), for as long as F is above the reference. Then the reference
+  // comes back to 1. The flux must turn at once: v2 > 0 at the first step the error is
+  // positive. An integrator that kept winding down at the floor held v2 at 0 for seconds (the
+  // IOL's stator flux then collapsed towards the law's singular state in the soak).
+  const double e = 0.9978351639822989;
+  FluxOuterLoop<double> loop(e, place_flux_outer_loop(e, 1e-3, 0.01));
+  double flux = 1.0;
+  for (int k = 0; k < 1000; ++k) {  // 1 s: F = e^2000 ~ 0.013, still above 0.01
+    const double v2 = loop.step(0.01, flux * flux);
+    ASSERT_NEAR(v2, 0.0, 1e-15) << k;  // at the floor throughout
+    flux = next_flux(flux, v2, e, 0.0);
+  }
+  ASSERT_GT(flux * flux, 0.01);
+  const double F = flux * flux;
+  const double v2 = loop.step(1.0, F);
+  // The linear design's first step from a clean integrator: (1 - e) + Kp (1 - F), at least.
+  const FluxOuterLoopGains g = place_flux_outer_loop(e, 1e-3, 0.01);
+  const double intended = e * F + (1.0 - e) + g.kp * (1.0 - F);
+  EXPECT_NEAR(v2, std::sqrt(F) * std::sqrt(intended) - e * F, 1e-12);
+}
+
 TEST(SpeedPi, ClosedLoopOnTheExactSpeedModelRejectsALoadStep) {
   // The speed row of paper 001's exact model, torque applied one period late (y1(k+1) = v1(k)).
   const auto motor = test::test_motors()[1].parameters;
