@@ -33,19 +33,18 @@ class IolLaw final : public ControlLaw<T> {
   }
 
   LawOutput<T> step(const LawInput<T>& in, LawDiagnostics<T>& report) noexcept override {
-    const IolTickResult<T> r = stage_.tick(in.e.x.flux_r_AB_Wb, in.e.x.omega_mech_rad_s, in.ahead,
-                                           in.v_max_V, in.e.x.i_s_AB_A);
+    const IolTickResult<T> r =
+        stage_.tick(in.e.x.flux_r_AB_Wb, in.e.x.omega_mech_rad_s, in.ahead, in.v_max_V,
+                    in.e.x.i_s_AB_A);
     LawOutput<T> out;
     out.ok = r.status == control::IolStatus::ok;
     out.i_cmd_AB_A = r.i_cmd_AB_A;
     const control::Vec2<T> wanted =
         current_loop_.wanted(in.e.x_input.flux_r_AB_Wb, in.e.x_input.i_s_AB_A, r.i_cmd_AB_A);
     out.v_AB_V = in.feasible.clamp(wanted);
-    const bool cut = !in.feasible.contains(wanted);
-    if (cut) stage_.current_fell_short();
-    report.limit = cut                  ? Limitation::input
-                   : r.torque_held_back ? Limitation::torque
-                                        : Limitation::none;
+    report.limit = !in.feasible.contains(wanted) ? Limitation::input
+                   : r.torque_held_back         ? Limitation::torque
+                                                : Limitation::none;
     report.i_held_AB_A = r.i_held_AB_A;
     report.iol_boundary = r.boundary;
     if (r.boundary) {
@@ -61,7 +60,9 @@ class IolLaw final : public ControlLaw<T> {
 
   /// Takes over the state of the object this one replaces (the same motor but for its
   /// rotor resistance): the tick changes coefficients and keeps state (docs/robustness.md).
-  void continue_from(const IolLaw& old) noexcept { stage_.continue_from(old.stage_); }
+  void continue_from(const IolLaw& old) noexcept {
+    stage_.continue_from(old.stage_);
+  }
 
  private:
   IolStage<T> stage_;

@@ -85,11 +85,7 @@ class IolStage {
     if (phase == 0) {
       // A boundary: the current computed one period ago, u(k-1) = i(t_k), is imposed now and
       // held until the next boundary; the law computes u(k) = i(t_{k+1}) (augmented model (19)).
-      // Where the current loop was held at the voltage limit for the whole period that ends,
-      // its command did not arrive and will not now: the law's model would hold a current that
-      // does not flow, and ask for ever more. It holds the current that flows instead.
-      i_held_ = cut_ticks_ >= ticks_per_period_ && !current_imposed_ ? i_est_AB_A : i_next_;
-      cut_ticks_ = 0;
+      i_held_ = i_next_;
       r.boundary = true;
     }
     // u(k) is known a whole period ahead: it is commanded early enough for the current to be
@@ -112,7 +108,8 @@ class IolStage {
                           ? speed_pi_.step(ref_next.omega_mech_rad_s, omega_mech_rad_s)
                           : ref_next.torque_Nm;
     const T flux2_ref =
-        std::min(ref_next.stator_flux2_Wb2, voltage_limited_flux2_Wb2(omega_mech_rad_s, v_max_V));
+        std::min(ref_next.stator_flux2_Wb2,
+                 voltage_limited_flux2_Wb2(omega_mech_rad_s, v_max_V));
     r.y2_ref = outer_flux_loop_ ? flux_loop_.step(flux2_ref, r.flux2_s_Wb2)
                                 : one_minus_flux_decay_ * flux2_ref;  // (21)
     const control::IolOutput<T> out = law_.step({flux_s, i_held_, r.torque_ref_Nm, r.y2_ref});
@@ -124,9 +121,6 @@ class IolStage {
     i_next_ = out.i_next_AB_A;
     return r;
   }
-
-  /// The current loop could not reach this tick's command (its voltage was cut to the limit).
-  void current_fell_short() noexcept { ++cut_ticks_; }
 
   /// Field weakening by the 1/w law: the squared stator flux whose back-EMF p |w| |phi_s| fits
   /// the share of v_max every law uses (control/field_weakening.hpp). With Rs neglected this
@@ -156,7 +150,6 @@ class IolStage {
     flux_s_before_ = old.flux_s_before_;
     phase_ = old.phase_;
     torque_held_back_ = old.torque_held_back_;
-    cut_ticks_ = old.cut_ticks_;
   }
 
  private:
@@ -165,7 +158,7 @@ class IolStage {
   control::FluxOuterLoop<T> flux_loop_;
   control::SpeedPi<T> speed_pi_;
   int ticks_per_period_;
-  int lead_ticks_;        ///< ticks before a boundary at which u(k) is commanded
+  int lead_ticks_;  ///< ticks before a boundary at which u(k) is commanded
   bool current_imposed_;  ///< an ideal current source: the held current is the current
   bool outer_speed_loop_, outer_flux_loop_;
   T sigma_H_, Lm_over_Lr_;
@@ -176,7 +169,6 @@ class IolStage {
   control::Vec2<T> flux_s_before_ = control::Vec2<T>::Zero();
   int phase_ = 0;  ///< ticks since the last T0 boundary, 0 at a boundary's tick
   bool torque_held_back_ = false;
-  int cut_ticks_ = 0;  ///< ticks of this period whose voltage was cut to the limit
 };
 
 }  // namespace imd::firmware

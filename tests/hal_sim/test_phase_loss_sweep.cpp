@@ -10,10 +10,10 @@
 #include <string>
 #include <vector>
 
+#include "fault_events_text.hpp"
 #include "hal_sim/drive/scenario_run.hpp"
 #include "hal_sim/law_variant.hpp"
 #include "hal_sim/scenario.hpp"
-#include "fault_events_text.hpp"
 #include "test_motors.hpp"
 
 namespace imd::sim {
@@ -52,8 +52,7 @@ TEST(PhaseLossSweep, AnOpenPhaseIsFoundAtAnyTimeWithEveryLaw) {
       EXPECT_GE(latency_s, 0.0);
       worst_s = std::max(worst_s, latency_s);
     }
-    std::printf("open phase, %s: 30 injections found, worst latency %.1f ms\n", law,
-                worst_s * 1e3);
+    std::printf("open phase, %s: 30 injections found, worst latency %.1f ms\n", law, worst_s * 1e3);
     EXPECT_LT(worst_s, 0.060) << law;
   }
 }
@@ -68,7 +67,7 @@ TEST(PhaseLossSweep, NoFalseTripOnAHealthyMotor) {
                           "hal_sim/scenarios/seed001_realistic.toml",
                           "tests/data/scenarios/small_4pole_750W_realistic.toml",
                           "tests/data/scenarios/six_pole_7kW_realistic.toml"};
-  int runs = 0, law_failures = 0;
+  int runs = 0;
   for (const char* file : boards) {
     for (const char* law : kLaws) {
       for (const double flux_share : {1.0, 0.6}) {
@@ -85,18 +84,12 @@ TEST(PhaseLossSweep, NoFalseTripOnAHealthyMotor) {
           s.settle_s = 3.5;
           const Summary r = run_scenario(s);
           ++runs;
-          // Every run must have reached running; a law that cannot solve for its input
-          // (singular_control: the IOL at standstill under load at 0.6 of the flux on the
-          // paper-000 motor, whose stator flux collapses) is the law's failure, reported, not
-          // a check's false trip.
+          // Every run must have reached running, and nothing may trip: not a check, and not
+          // the law's own singular_control (the IOL at 0.6 of the paper-000 motor's flux,
+          // standstill under load, tripped it until its outer flux loop stopped winding up at its
+          // floor: docs/iol.md).
           EXPECT_LT(r.running_from_s, 1.5) << file << " " << law;
           for (const FaultEvent& f : r.faults) {
-            if (f.code == "singular_control") {
-              ++law_failures;
-              std::printf("law failure: %s %s flux x%.1f seed %d at %.3f s\n", file, law,
-                          flux_share, seed, f.detected_at_s);
-              continue;
-            }
             ADD_FAILURE() << file << " " << law << " flux x" << flux_share << " seed " << seed
                           << ": " << f.code << " at " << f.detected_at_s << " s";
           }
@@ -104,8 +97,7 @@ TEST(PhaseLossSweep, NoFalseTripOnAHealthyMotor) {
       }
     }
   }
-  std::printf("healthy sweep: %d runs, no check tripped, %d law failures\n", runs,
-              law_failures);
+  std::printf("healthy sweep: %d runs, nothing tripped\n", runs);
 }
 
 TEST(PhaseLossSweep, NoFalseTripOnThePaperScenarios) {
@@ -138,10 +130,10 @@ TEST(PhaseLossSweep, NoFalseTripOnTheRealisticBoardAtOtherSamplePeriods) {
   int runs = 0;
   for (const double period_s : {5e-5, 2e-4, 5e-4, 1e-3}) {
     for (const char* law : {"dsmc", "ifoc"}) {
-      const Summary r = run_scenario(
-          load_scenario(test::source_path("hal_sim/scenarios/seed000_realistic.toml"),
-                        {"drive.sample_period_s=" + std::to_string(period_s),
-                         std::string("drive.controller=") + law}));
+      const Summary r =
+          run_scenario(load_scenario(test::source_path("hal_sim/scenarios/seed000_realistic.toml"),
+                                     {"drive.sample_period_s=" + std::to_string(period_s),
+                                      std::string("drive.controller=") + law}));
       ++runs;
       EXPECT_TRUE(r.faults.empty()) << period_s << " s, " << law << ": " << faults_text(r);
       EXPECT_LT(r.running_from_s, 0.5) << period_s << " s, " << law;
