@@ -14,8 +14,8 @@ endforeach()
 foreach(name test_standstill_identification test_inertia_identification)
   imd_add_test(${name} sim LIBRARIES imd_firmware imd_hal_sim SOURCES firmware/${name}.cpp)
 endforeach()
-foreach(name test_protection test_supervisor test_protection_checks test_limitation
-             test_stop_category test_sense_stage test_protocol test_binary64)
+foreach(name test_protection test_supervisor test_protection_checks test_adc_stuck_check
+             test_limitation test_stop_category test_sense_stage test_protocol test_binary64)
   imd_add_test(${name} unit LIBRARIES imd_firmware SOURCES firmware/${name}.cpp)
 endforeach()
 imd_add_test(test_motor_record unit LIBRARIES imd_firmware tomlplusplus::tomlplusplus
@@ -36,7 +36,7 @@ set(IMD_FLOAT_DESIGN_TESTS
     test_drive_tick test_drive_commands test_dead_time test_drive_parameters
     test_drive_identification test_heartbeat_brake test_standstill_identification
     test_inertia_identification test_protection test_supervisor test_protection_checks
-    test_limitation test_stop_category test_sense_stage test_protocol test_binary64
+    test_adc_stuck_check test_limitation test_stop_category test_sense_stage test_protocol test_binary64
     test_motor_record test_estimate_stage test_voltage_fed_scenarios test_current_fed_scenarios
     test_rotor_resistance_tracking test_dsmc_torque_channel test_fault_matrix
     test_field_weakening test_phase_loss_sweep test_stop_categories test_fault_recovery
