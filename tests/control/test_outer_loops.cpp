@@ -102,15 +102,19 @@ TEST(FluxOuterLoop, DoesNotWindUpWhileTheFluxShrinksAtItsFastest) {
   double flux = 1.0;
   for (int k = 0; k < 1000; ++k) {  // 1 s: F = e^2000 ~ 0.013, still above 0.01
     const double v2 = loop.step(0.01, flux * flux);
-    ASSERT_NEAR(v2, 0.0, 1e-15) << k;  // at the floor throughout
+    // At the floor throughout: v2 = sqrt(F) sqrt(e^2 F) - e F is zero but for the rounding of
+    // two products of magnitude F <= 1 (a few 2^-53).
+    ASSERT_NEAR(v2, 0.0, 1e-15) << k;
     flux = next_flux(flux, v2, e, 0.0);
   }
   ASSERT_GT(flux * flux, 0.01);
   const double F = flux * flux;
   const double v2 = loop.step(1.0, F);
-  // The linear design's first step from a clean integrator: (1 - e) + Kp (1 - F), at least.
+  // The linear design's first step from an integrator the floor left at zero:
+  // v2_linear = (1 - e) + Kp (1 - F).
   const FluxOuterLoopGains g = place_flux_outer_loop(e, 1e-3, 0.01);
   const double intended = e * F + (1.0 - e) + g.kp * (1.0 - F);
+  // The same arithmetic in another order: only rounding (terms below 1) separates the two.
   EXPECT_NEAR(v2, std::sqrt(F) * std::sqrt(intended) - e * F, 1e-12);
 }
 
