@@ -14,10 +14,20 @@
 /// v1 is saturated dynamically: the largest |v1| <= |v1_ref| is used for which the exactly
 /// predicted fluxes of step k+1 stay within max_angle of each other. A state whose own B_k is
 /// (nearly) singular, a flux command that breaks the guard even without torque, and non-finite
-/// inputs are refused: the current is held. Tick context; no division by zero.
+/// inputs are refused: the current is held.
+///
+/// Reach (docs/iol.md, "At the voltage limit"): on a voltage inverter the current loop makes
+/// the step to u in one sample period, and a u outside the currents it reaches there
+/// (control/current_reach.hpp) does not arrive. Such a u is cut to the reachable disk with the
+/// torque given up first: to the point of the disk on the second output's line (y2(k+1) = v2
+/// is a line in u) whose torque is nearest v1, or, where that line misses the disk, to the
+/// disk's point nearest the line. A cut that would break the determinant guard is not made.
+/// Tick context; no division by zero.
+#include <algorithm>
 #include <cmath>
 
 #include "control/current_fed_model.hpp"
+#include "control/current_reach.hpp"
 #include "control/frames.hpp"
 #include "control/real.hpp"
 
@@ -41,6 +51,8 @@ struct IolInput {
   Vec2<T> i_s_AB_A = Vec2<T>::Zero();      ///< x3, x4: the current held over [t_k, t_{k+1})
   T torque_ref_Nm = T(0);                  ///< v1, the torque wanted at t_{k+1}
   T y2_ref = T(0);                         ///< v2, the second output wanted at t_{k+1} (Wb^2)
+  /// The currents the current loop reaches at t_{k+1}; unlimited for a current source.
+  CurrentDisk<T> reach;
 };
 
 template <typename T>
@@ -48,7 +60,8 @@ struct IolOutput {
   IolStatus status = IolStatus::singular;
   Vec2<T> i_next_AB_A = Vec2<T>::Zero();  ///< u = i(t_{k+1}): the current for the next period
   T torque_cmd_Nm = T(0);                 ///< v1 after the guard
-  bool torque_limited = false;
+  bool torque_limited = false;  ///< v1 cut, by the guard or by the reach
+  bool reach_limited = false;   ///< u cut to the reachable currents
   T det_B = T(0);       ///< det B_k
   T det_B_next = T(0);  ///< predicted det B_{k+1}
 };
@@ -121,6 +134,29 @@ class Iol {
       out.torque_limited = true;
       u = law(out.torque_cmd_Nm);
       next_fluxes_ok(u, &out.det_B_next);
+    }
+    if (!in.reach.contains(u)) {
+      // The second output's line n . u = w2 with n = (b21, b22) = ls sigma phi_s (24).
+      const Vec2<T> n = ls_sigma_ * flux;
+      const T w2 = in.y2_ref - a;
+      const Vec2<T> foot = in.reach.center_A + ((w2 - n.dot(in.reach.center_A)) / n.squaredNorm()) * n;
+      const Vec2<T> to_line = foot - in.reach.center_A;
+      const T distance2 = to_line.squaredNorm(), radius2 = in.reach.radius_A * in.reach.radius_A;
+      Vec2<T> cut;
+      if (distance2 <= radius2) {  // the chord: u's place on the line, clamped to it
+        const Vec2<T> along = J_times<T>(n) / n.norm();
+        const T half_chord = std::sqrt(radius2 - distance2);
+        cut = foot + std::clamp(along.dot(u - foot), -half_chord, half_chord) * along;
+      } else {
+        cut = in.reach.center_A + (in.reach.radius_A / std::sqrt(distance2)) * to_line;
+      }
+      T det_next;
+      if (next_fluxes_ok(cut, &det_next)) {
+        u = cut;
+        out.det_B_next = det_next;
+        out.torque_cmd_Nm = k_np_ * (flux_r.x() * u.y() - flux_r.y() * u.x());  // b1 . u
+        out.torque_limited = out.reach_limited = true;
+      }
     }
     out.i_next_AB_A = u;
     return out;

@@ -17,7 +17,7 @@ class IolLaw final : public ControlLaw<T> {
   static constexpr ControllerKind kKind = ControllerKind::iol;
 
   explicit IolLaw(const LawContext& c)
-      : stage_(c.motor, c.config),
+      : stage_(c.motor, c.config, c.coefficients),
         current_loop_(c.coefficients),
         follows_speed_(c.config.outer_speed_loop) {}
 

@@ -11,6 +11,7 @@
 #include <limits>
 
 #include "control/current_fed_model.hpp"
+#include "control/current_reach.hpp"
 #include "control/field_weakening.hpp"
 #include "control/flux_outer_loop.hpp"
 #include "control/frames.hpp"
@@ -40,9 +41,13 @@ struct IolTickResult {
 template <typename T>
 class IolStage {
  public:
-  IolStage(const control::MotorParameters& motor, const DriveConfig& config)
+  /// `tick_model`: the voltage-fed model at the sample period, on which the current loop
+  /// makes the law's current steps.
+  IolStage(const control::MotorParameters& motor, const DriveConfig& config,
+           const control::VoltageFedCoefficients& tick_model)
       : coefficients_(control::discretize_current_fed<T>(motor, config.iol_period_s)),
         law_(coefficients_, control::IolConfig{}),
+        reach_(motor, tick_model),
         flux_loop_(coefficients_.flux_decay,
                    control::place_flux_outer_loop(coefficients_.flux_decay, config.iol_period_s,
                                                   config.flux_loop_time_constant_s)),
@@ -51,6 +56,8 @@ class IolStage {
         ticks_per_period_(
             static_cast<int>(std::lround(config.iol_period_s / config.sample_period_s))),
         lead_ticks_(config.current_response_ticks + config.pwm_latency_ticks),
+        reach_ticks_(std::max(1, ticks_per_period_ - lead_ticks_ + 1)),
+        current_limit_A_(T(config.current_margin * config.i_max_A)),
         current_imposed_(config.current_response_ticks == 0),
         outer_speed_loop_(config.outer_speed_loop),
         outer_flux_loop_(config.outer_flux_loop),
@@ -112,7 +119,17 @@ class IolStage {
                  voltage_limited_flux2_Wb2(omega_mech_rad_s, v_max_V));
     r.y2_ref = outer_flux_loop_ ? flux_loop_.step(flux2_ref, r.flux2_s_Wb2)
                                 : one_minus_flux_decay_ * flux2_ref;  // (21)
-    const control::IolOutput<T> out = law_.step({flux_s, i_held_, r.torque_ref_Nm, r.y2_ref});
+    // The current loop starts the step to u(k) from the held current one tick before the next
+    // boundary; u(k) must be there before u(k + 1) is commanded, reach_ticks_ later. An ideal
+    // current source makes any step.
+    const control::CurrentDisk<T> reach =
+        current_imposed_
+            ? control::CurrentDisk<T>{}
+            : control::within_current_limit(
+                  reach_.disk(flux_r_AB_Wb, i_held_, omega_mech_rad_s, v_max_V, reach_ticks_),
+                  current_limit_A_);
+    const control::IolOutput<T> out =
+        law_.step({flux_s, i_held_, r.torque_ref_Nm, r.y2_ref, reach});
     r.status = out.status;
     r.torque_cmd_Nm = out.torque_cmd_Nm;
     r.torque_limited = out.torque_limited;
@@ -155,10 +172,15 @@ class IolStage {
  private:
   control::CurrentFedCoefficients coefficients_;
   control::Iol<T> law_;
+  control::CurrentReach<T> reach_;
   control::FluxOuterLoop<T> flux_loop_;
   control::SpeedPi<T> speed_pi_;
   int ticks_per_period_;
   int lead_ticks_;  ///< ticks before a boundary at which u(k) is commanded
+  /// Ticks of voltage the current loop has for the step to u(k): from the tick before the
+  /// boundary until u(k + 1) is commanded, lead_ticks_ before the next one.
+  int reach_ticks_;
+  T current_limit_A_;  ///< what the current loop plans within (+inf: no limit)
   bool current_imposed_;  ///< an ideal current source: the held current is the current
   bool outer_speed_loop_, outer_flux_loop_;
   T sigma_H_, Lm_over_Lr_;

@@ -41,6 +41,7 @@ class PhaseLossCheck {
         noise_floor_A_(T(c.noise_floor_A)),
         carried_share_(T(c.carried_share)) {}
 
+  uint32_t window_ticks() const noexcept { return window_ticks_; }
   void reset() noexcept {
     std::fill(std::begin(predicted_A_), std::end(predicted_A_), T(0));
     std::fill(std::begin(measured_A_), std::end(measured_A_), T(0));

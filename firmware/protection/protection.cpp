@@ -76,7 +76,9 @@ MotorChecks<T>::MotorChecks(const control::MotorParameters& motor,
       encoder(encoder_config<T>(motor, c, config, counts_per_rev)),
       adc_stuck(config.protection.adc_stuck_ticks, adc_A_per_code,
                 control::derive_voltage_fed(motor).sigma_H, config.sample_period_s),
-      phase_loss(phase_loss_config<T>(motor, config, adc_A_per_code)) {}
+      phase_loss(phase_loss_config<T>(motor, config, adc_A_per_code)),
+      law_failure(2 * std::max(phase_loss.window_ticks(),
+                               static_cast<uint32_t>(std::max(config.protection.adc_stuck_ticks, 1)))) {}
 
 template <typename T>
 Protection<T>::Protection(const DriveConfig& config) noexcept
@@ -120,7 +122,7 @@ Trip Protection<T>::check(const Measurement<T>& m, const Estimate<T>& e, const S
     trip.add(FaultCode::magnetizing_timeout);
     return trip;
   }
-  if (!law.ok) trip.add(FaultCode::singular_control);
+  if (motor->law_failure.failed(law.ok)) trip.add(FaultCode::singular_control);
   if (!out.finite) trip.add(FaultCode::non_finite);
   return trip;
 }

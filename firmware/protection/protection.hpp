@@ -23,6 +23,7 @@
 #include "firmware/laws/control_law.hpp"
 #include "firmware/protection/adc_stuck_check.hpp"
 #include "firmware/protection/encoder_check.hpp"
+#include "firmware/protection/law_failure_check.hpp"
 #include "firmware/protection/phase_loss_check.hpp"
 #include "firmware/protection/trip.hpp"
 #include "firmware/stages/estimate.hpp"
@@ -66,12 +67,14 @@ struct MotorChecks {
   void idle() noexcept {
     adc_stuck.reset();
     phase_loss.idle();
+    law_failure.reset();
   }
   /// Takes over the checks' state from the model this one replaces (firmware/motor_model.hpp).
   void continue_from(const MotorChecks& old) noexcept {
     encoder.continue_from(old.encoder);
     adc_stuck.continue_from(old.adc_stuck);
     phase_loss.continue_from(old.phase_loss);
+    law_failure.continue_from(old.law_failure);
   }
 
   /// The encoder check's load bound: max_load_share of the torque at the current limit with
@@ -90,6 +93,7 @@ struct MotorChecks {
   EncoderCheck<T> encoder;
   AdcStuckCheck<T> adc_stuck;
   PhaseLossCheck<T> phase_loss;
+  LawFailureCheck law_failure;
 };
 
 template <typename T>

@@ -1,5 +1,5 @@
 // The input-output linearizing law of paper 001, Section 4, against the exact discrete model:
-// decoupling, and the determinant guard.
+// decoupling, the determinant guard, and the cut to the currents the current loop reaches.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -134,6 +134,55 @@ TEST_F(IolTest, AFluxCommandThatBreaksTheGuardByItselfIsRefused) {
   EXPECT_EQ(iol.step(in).status, IolStatus::singular);
   in.y2_ref = 0.002;
   EXPECT_EQ(iol.step(in).status, IolStatus::ok);
+}
+
+TEST_F(IolTest, AnUnreachableCommandKeepsTheFluxAndGivesUpTorque) {
+  // The reach around the held current, smaller than the step the full torque asks for, but
+  // wide enough for the flux output's line: u is cut onto that line, at the torque nearest v1.
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> angle(-std::numbers::pi, std::numbers::pi),
+      torque(-240.0, 240.0), flux2(0.6, 1.0), share(0.05, 0.6);
+  for (int trial = 0; trial < 200; ++trial) {
+    IolInput<double> in = operating_point(angle(rng), torque(rng), flux2(rng));
+    const IolOutput<double> free = iol.step(in);
+    ASSERT_FALSE(free.torque_limited);
+    const Vec2<double> flux_only = iol.step({in.flux_s_AB_Wb, in.i_s_AB_A, 0.0, in.y2_ref, {}}).i_next_AB_A;
+    // A disk around the flux-only command (on the line) that leaves out the full command.
+    in.reach = {flux_only, share(rng) * (free.i_next_AB_A - flux_only).norm()};
+    const IolOutput<double> out = iol.step(in);
+    ASSERT_EQ(out.status, IolStatus::ok);
+    EXPECT_TRUE(out.reach_limited);
+    EXPECT_TRUE(out.torque_limited);
+    // On the disk's edge (the full command is outside; the chord's end nearest it). Rounding:
+    // a few ulps of the currents, |u| <= 300 A here.
+    EXPECT_NEAR((out.i_next_AB_A - in.reach.center_A).norm(), in.reach.radius_A, 1e-12 * 300.0);
+    // The second output is still exact: u is on its line (the tolerance of the decoupling test).
+    const Vec2<double> flux_next =
+        model.next_stator_flux(in.flux_s_AB_Wb, in.i_s_AB_A, out.i_next_AB_A);
+    EXPECT_NEAR(iol.y2(flux_next, in.flux_s_AB_Wb), in.y2_ref, 1e-12 * std::abs(in.y2_ref));
+    // The torque given up, not reversed, and the one reported is the one produced.
+    EXPECT_LT(std::abs(out.torque_cmd_Nm), std::abs(in.torque_ref_Nm));
+    EXPECT_GE(out.torque_cmd_Nm * in.torque_ref_Nm, 0.0);
+    EXPECT_NEAR(model.torque_Nm(flux_next, out.i_next_AB_A), out.torque_cmd_Nm, 1e-12 * 240.0);
+  }
+}
+
+TEST_F(IolTest, WhereTheFluxLineMissesTheReachTheNearestCurrentIsTaken) {
+  IolInput<double> in = operating_point(0.3, 100.0, 0.8);
+  const IolOutput<double> free = iol.step(in);
+  // The flux line's normal is n = ls sigma phi_s; a disk centred 2 A off the line (along n,
+  // on the held current's side) with radius 1 A cannot meet it.
+  const Vec2<double> normal = in.flux_s_AB_Wb.normalized();
+  const double side = normal.dot(in.i_s_AB_A - free.i_next_AB_A) >= 0.0 ? 1.0 : -1.0;
+  in.reach = {free.i_next_AB_A + side * 2.0 * normal, 1.0};
+  const IolOutput<double> out = iol.step(in);
+  ASSERT_EQ(out.status, IolStatus::ok);
+  EXPECT_TRUE(out.reach_limited);
+  // The disk's point nearest the line: 1 A from the centre, towards the line along -n.
+  EXPECT_NEAR((out.i_next_AB_A - (in.reach.center_A - side * normal)).norm(), 0.0, 1e-12 * 300.0);
+  // An unlimited reach changes nothing: the same command to the bit.
+  in.reach = {};
+  EXPECT_EQ(iol.step(in).i_next_AB_A, free.i_next_AB_A);
 }
 
 }  // namespace

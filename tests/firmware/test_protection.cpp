@@ -131,15 +131,34 @@ TEST(Protection, MagnetizingTimesOutAfterItsTicks) {
             FaultCode::magnetizing_timeout);
 }
 
-TEST(Protection, ALawWithoutSolutionAndANonFiniteOutputTrip) {
+TEST(Protection, ALawWithoutSolutionTripsAfterItsWindowAndANonFiniteOutputAtOnce) {
   Bench b;
   MotorProtection p = b.make();
+  // The paper-000 motor at 100 us: the phase-loss window is its transient time constant,
+  // ceil(1 / (gamma T)) = 25 ticks, longer than the stuck-ADC check's 20: two of them.
+  const uint32_t window = p.motor.law_failure.window_ticks();
+  EXPECT_EQ(window, 2u * p.motor.phase_loss.window_ticks());
+  EXPECT_EQ(p.motor.phase_loss.window_ticks(), 25u);
   b.law.ok = false;
-  b.out.finite = false;
+  for (uint32_t k = 1; k < window; ++k) {
+    ASSERT_FALSE(p.check(b.m, b.e, b.s, b.law, b.out).any()) << k;
+  }
+  // One solution in between starts the count again.
+  b.law.ok = true;
+  EXPECT_FALSE(p.check(b.m, b.e, b.s, b.law, b.out).any());
+  b.law.ok = false;
+  for (uint32_t k = 1; k < window; ++k) {
+    ASSERT_FALSE(p.check(b.m, b.e, b.s, b.law, b.out).any()) << k;
+  }
   const Trip t = p.check(b.m, b.e, b.s, b.law, b.out);
   EXPECT_EQ(t.first, FaultCode::singular_control);
-  EXPECT_EQ(t.bits, (1u << unsigned(FaultCode::singular_control)) |
-                        (1u << unsigned(FaultCode::non_finite)));
+  // A non-finite output trips in its own tick, beside it.
+  b.out.finite = false;
+  const Trip both = p.check(b.m, b.e, b.s, b.law, b.out);
+  EXPECT_EQ(both.bits, (1u << unsigned(FaultCode::singular_control)) |
+                           (1u << unsigned(FaultCode::non_finite)));
+  b.law.ok = true;
+  EXPECT_EQ(p.check(b.m, b.e, b.s, b.law, b.out).first, FaultCode::non_finite);
 }
 
 TEST(Protection, TheCommandWatchdogNeedsCanCommands) {

@@ -172,8 +172,10 @@ TEST(DriveAt20kHz, TimesGivenInSecondsDoubleInTicks) {
   // Paper 001's law on its T0 = 1 ms: 20 ticks per step instead of 10, the same law.
   const Scenario i10 = at_period("hal_sim/scenarios/seed001_realistic.toml", k10kHz_s);
   const Scenario i20 = at_period("hal_sim/scenarios/seed001_realistic_20kHz.toml", k20kHz_s);
-  const firmware::IolStage<double> iol10(i10.motor, drive_config(i10));
-  const firmware::IolStage<double> iol20(i20.motor, drive_config(i20));
+  const firmware::IolStage<double> iol10(i10.motor, drive_config(i10),
+                                         control::discretize_voltage_fed(i10.motor, k10kHz_s));
+  const firmware::IolStage<double> iol20(i20.motor, drive_config(i20),
+                                         control::discretize_voltage_fed(i20.motor, k20kHz_s));
   EXPECT_EQ(iol10.ticks_per_period(), 10);
   EXPECT_EQ(iol20.ticks_per_period(), 20);
   EXPECT_DOUBLE_EQ(iol20.coefficients().flux_decay, iol10.coefficients().flux_decay);
