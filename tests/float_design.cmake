@@ -25,8 +25,9 @@ imd_add_test(test_estimate_stage unit LIBRARIES imd_firmware tomlplusplus::tomlp
 target_compile_options(test_estimate_stage PRIVATE -ffp-contract=off)  # bit-for-bit (the test)
 foreach(name test_voltage_fed_scenarios test_current_fed_scenarios test_rotor_resistance_tracking
              test_dsmc_torque_channel test_fault_matrix test_field_weakening test_phase_loss_sweep
-             test_stop_categories test_fault_recovery test_encoder_check_sweep
-             test_adc_stuck_sweep test_commissioning_scenarios test_lockstep_agreement
+             test_iol_voltage_limit_sweep test_stop_categories test_fault_recovery
+             test_encoder_check_sweep test_adc_stuck_sweep test_commissioning_scenarios
+             test_lockstep_agreement
              test_drive_at_20kHz)
   imd_add_test(${name} sim LIBRARIES imd_sim_drive SOURCES hal_sim/${name}.cpp)
 endforeach()
@@ -39,7 +40,7 @@ set(IMD_FLOAT_DESIGN_TESTS
     test_adc_stuck_check test_limitation test_stop_category test_sense_stage test_protocol test_binary64
     test_motor_record test_estimate_stage test_voltage_fed_scenarios test_current_fed_scenarios
     test_rotor_resistance_tracking test_dsmc_torque_channel test_fault_matrix
-    test_field_weakening test_phase_loss_sweep test_stop_categories test_fault_recovery
-    test_encoder_check_sweep test_adc_stuck_sweep test_commissioning_scenarios
+    test_field_weakening test_phase_loss_sweep test_iol_voltage_limit_sweep test_stop_categories
+    test_fault_recovery test_encoder_check_sweep test_adc_stuck_sweep test_commissioning_scenarios
     test_lockstep_agreement test_drive_at_20kHz)
 add_custom_target(float_design_tests DEPENDS ${IMD_FLOAT_DESIGN_TESTS})
