@@ -13,6 +13,7 @@
 #include "hal_sim/drive/scenario_run.hpp"
 #include "hal_sim/law_variant.hpp"
 #include "hal_sim/scenario.hpp"
+#include "realistic_boards.hpp"
 #include "fault_events_text.hpp"
 #include "test_motors.hpp"
 
@@ -63,12 +64,8 @@ TEST(AdcStuckSweep, BothFaultsKeepTheirCodesOnFourMotorsUnderAnUnshippedProfile)
   // and an open phase are injected while the motor turns (at standstill under a still voltage
   // neither is observable: docs/safety.md), at 0.9 s, 1.5 s and 2.5 s. Each must be latched
   // with its own code within the run's 0.6 s after it.
-  const char* boards[] = {"hal_sim/scenarios/seed000_realistic.toml",
-                          "hal_sim/scenarios/seed001_realistic.toml",
-                          "tests/data/scenarios/small_4pole_750W_realistic.toml",
-                          "tests/data/scenarios/six_pole_7kW_realistic.toml"};
   int runs = 0;
-  for (const char* file : boards) {
+  for (const char* file : test_boards::kRealistic) {
     for (const char* law : {"dsmc", "ifoc", "iol"}) {
       for (const FaultKind kind : {FaultKind::adc_stuck, FaultKind::phase_loss}) {
         for (const double at_s : {0.9, 1.5, 2.5}) {

@@ -14,6 +14,7 @@
 #include "hal_sim/drive/scenario_run.hpp"
 #include "hal_sim/law_variant.hpp"
 #include "hal_sim/scenario.hpp"
+#include "realistic_boards.hpp"
 #include "test_motors.hpp"
 
 namespace imd::sim {
@@ -63,12 +64,8 @@ TEST(PhaseLossSweep, NoFalseTripOnAHealthyMotor) {
   // scenario runs: forward at 0.4 of base speed, a load step to half the torque at the current
   // limit, reversal to -0.3 of base speed against an overhauling quarter, standstill under a
   // third, two noise seeds. No run may trip anything.
-  const char* boards[] = {"hal_sim/scenarios/seed000_realistic.toml",
-                          "hal_sim/scenarios/seed001_realistic.toml",
-                          "tests/data/scenarios/small_4pole_750W_realistic.toml",
-                          "tests/data/scenarios/six_pole_7kW_realistic.toml"};
   int runs = 0;
-  for (const char* file : boards) {
+  for (const char* file : test_boards::kRealistic) {
     for (const char* law : kLaws) {
       for (const double flux_share : {1.0, 0.6}) {
         for (const int seed : {1, 2}) {
