@@ -74,7 +74,7 @@ class CurrentReach {
 
  private:
   T a21_, a22_, b2_;
-  T sigma_p_H_;   ///< sigma p: the feedback's gain on w J (I~ + beta Phi~)
+  T sigma_p_H_;  ///< sigma p: the feedback's gain on w J (I~ + beta Phi~)
   T beta_per_H_;
 };
 

@@ -17,8 +17,8 @@
 /// inputs are refused: the current is held.
 ///
 /// Reach (docs/iol.md, "At the voltage limit"): on a voltage inverter the current loop makes
-/// the step to u in one sample period, and a u outside the currents it reaches there
-/// (control/current_reach.hpp) does not arrive. Such a u is cut to the reachable disk with the
+/// the step to u from the held current, and a u outside the currents it reaches before the law
+/// steps again (control/current_reach.hpp) does not arrive. Such a u is cut to that disk with the
 /// torque given up first: to the point of the disk on the second output's line (y2(k+1) = v2
 /// is a line in u) whose torque is nearest v1, or, where that line misses the disk, to the
 /// disk's point nearest the line. A cut that would break the determinant guard is not made.
@@ -60,10 +60,10 @@ struct IolOutput {
   IolStatus status = IolStatus::singular;
   Vec2<T> i_next_AB_A = Vec2<T>::Zero();  ///< u = i(t_{k+1}): the current for the next period
   T torque_cmd_Nm = T(0);                 ///< v1 after the guard
-  bool torque_limited = false;  ///< v1 cut, by the guard or by the reach
-  bool reach_limited = false;   ///< u cut to the reachable currents
-  T det_B = T(0);       ///< det B_k
-  T det_B_next = T(0);  ///< predicted det B_{k+1}
+  bool torque_limited = false;            ///< v1 cut, by the guard or by the reach
+  bool reach_limited = false;             ///< u cut to the reachable currents
+  T det_B = T(0);                         ///< det B_k
+  T det_B_next = T(0);                    ///< predicted det B_{k+1}
 };
 
 template <typename T>
@@ -139,7 +139,8 @@ class Iol {
       // The second output's line n . u = w2 with n = (b21, b22) = ls sigma phi_s (24).
       const Vec2<T> n = ls_sigma_ * flux;
       const T w2 = in.y2_ref - a;
-      const Vec2<T> foot = in.reach.center_A + ((w2 - n.dot(in.reach.center_A)) / n.squaredNorm()) * n;
+      const Vec2<T> foot =
+          in.reach.center_A + ((w2 - n.dot(in.reach.center_A)) / n.squaredNorm()) * n;
       const Vec2<T> to_line = foot - in.reach.center_A;
       const T distance2 = to_line.squaredNorm(), radius2 = in.reach.radius_A * in.reach.radius_A;
       Vec2<T> cut;

@@ -115,8 +115,7 @@ class IolStage {
                           ? speed_pi_.step(ref_next.omega_mech_rad_s, omega_mech_rad_s)
                           : ref_next.torque_Nm;
     const T flux2_ref =
-        std::min(ref_next.stator_flux2_Wb2,
-                 voltage_limited_flux2_Wb2(omega_mech_rad_s, v_max_V));
+        std::min(ref_next.stator_flux2_Wb2, voltage_limited_flux2_Wb2(omega_mech_rad_s, v_max_V));
     r.y2_ref = outer_flux_loop_ ? flux_loop_.step(flux2_ref, r.flux2_s_Wb2)
                                 : one_minus_flux_decay_ * flux2_ref;  // (21)
     // The current loop starts the step to u(k) from the held current one tick before the next
@@ -180,7 +179,7 @@ class IolStage {
   /// Ticks of voltage the current loop has for the step to u(k): from the tick before the
   /// boundary until u(k + 1) is commanded, lead_ticks_ before the next one.
   int reach_ticks_;
-  T current_limit_A_;  ///< what the current loop plans within (+inf: no limit)
+  T current_limit_A_;     ///< what the current loop plans within (+inf: no limit)
   bool current_imposed_;  ///< an ideal current source: the held current is the current
   bool outer_speed_loop_, outer_flux_loop_;
   T sigma_H_, Lm_over_Lr_;

@@ -77,8 +77,9 @@ MotorChecks<T>::MotorChecks(const control::MotorParameters& motor,
       adc_stuck(config.protection.adc_stuck_ticks, adc_A_per_code,
                 control::derive_voltage_fed(motor).sigma_H, config.sample_period_s),
       phase_loss(phase_loss_config<T>(motor, config, adc_A_per_code)),
-      law_failure(2 * std::max(phase_loss.window_ticks(),
-                               static_cast<uint32_t>(std::max(config.protection.adc_stuck_ticks, 1)))) {}
+      law_failure(
+          2 * std::max(phase_loss.window_ticks(),
+                       static_cast<uint32_t>(std::max(config.protection.adc_stuck_ticks, 1)))) {}
 
 template <typename T>
 Protection<T>::Protection(const DriveConfig& config) noexcept

@@ -30,8 +30,9 @@ std::pair<Vec2<double>, double> run(const VoltageFedModel<double>& model,
   double drift = 0.0;
   for (int j = 0; j < ticks; ++j) {
     // v~ = u_AB - sigma p w J (I~ + beta Phi~): the feedback (2) the current loop runs under.
-    const Vec2<double> v = voltage(j) - k.sigma_H * motor.pole_pairs * x.omega_mech_rad_s *
-                                            J_times<double>(x.i_s_AB_A + k.beta_per_H * x.flux_r_AB_Wb);
+    const Vec2<double> v =
+        voltage(j) - k.sigma_H * motor.pole_pairs * x.omega_mech_rad_s *
+                         J_times<double>(x.i_s_AB_A + k.beta_per_H * x.flux_r_AB_Wb);
     const double omega = x.omega_mech_rad_s;
     x = model.predict(x, v, 0.0);
     x.omega_mech_rad_s = omega;  // the disk takes the speed of its state
@@ -42,7 +43,8 @@ std::pair<Vec2<double>, double> run(const VoltageFedModel<double>& model,
 
 TEST(CurrentReach, IsTheDiskTheExactModelReaches) {
   std::mt19937_64 rng(11);
-  std::uniform_real_distribution<double> unit(-1.0, 1.0), angle(-std::numbers::pi, std::numbers::pi);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0),
+      angle(-std::numbers::pi, std::numbers::pi);
   for (const test::TestMotor& m : test::test_motors()) {
     const VoltageFedCoefficients c = discretize_voltage_fed(m.parameters, kTick_s);
     const VoltageFedModel<double> model(c);
@@ -61,13 +63,14 @@ TEST(CurrentReach, IsTheDiskTheExactModelReaches) {
         // most sum_j |A|^(m-1-j) |a21 - i b2 sigma p w beta| times the flux's drift (the
         // forcing term of each tick), plus rounding on the current's scale.
         const double turn = c.b2 * k.sigma_H * m.parameters.pole_pairs * x.omega_mech_rad_s;
-        const double gain = std::hypot(c.a22, turn), forcing = std::hypot(c.a21, turn * k.beta_per_H);
+        const double gain = std::hypot(c.a22, turn),
+                     forcing = std::hypot(c.a21, turn * k.beta_per_H);
         double gains = 0.0;
         for (int j = 0; j < ticks; ++j) gains += std::pow(gain, j);
         const double rounding = 1e-12 * (m.current_A + disk.radius_A);
         // No stator voltage: the free response, the centre.
-        const auto [free, drift0] =
-            run(model, m.parameters, x, ticks, [](int) -> Vec2<double> { return Vec2<double>::Zero(); });
+        const auto [free, drift0] = run(model, m.parameters, x, ticks,
+                                        [](int) -> Vec2<double> { return Vec2<double>::Zero(); });
         EXPECT_LE((free - disk.center_A).norm(), gains * forcing * drift0 + rounding)
             << m.name << " ticks " << ticks;
         // Every tick's voltage on the limit, turned so that each tick's contribution
@@ -101,7 +104,8 @@ TEST(CurrentReach, IsTheDiskTheExactModelReaches) {
 TEST(CurrentReach, NoVoltageLimitReachesEveryCurrent) {
   const test::TestMotor m = test::test_motors()[0];
   const CurrentReach<double> reach(m.parameters, discretize_voltage_fed(m.parameters, kTick_s));
-  const CurrentDisk<double> disk = reach.disk({0.5, 0.0}, {1.0, 2.0}, 100.0, std::numeric_limits<double>::infinity(), 3);
+  const CurrentDisk<double> disk =
+      reach.disk({0.5, 0.0}, {1.0, 2.0}, 100.0, std::numeric_limits<double>::infinity(), 3);
   EXPECT_TRUE(disk.unlimited());
   EXPECT_TRUE(disk.contains({1e6, -1e6}));
   EXPECT_TRUE(reach.disk({0.5, 0.0}, {1.0, 2.0}, 100.0, NAN, 3).unlimited());
@@ -116,7 +120,9 @@ TEST(CurrentReach, TheCurrentLimitNarrowsTheDisk) {
   // Inside the limit the reach is kept as it is; no limit keeps it too.
   EXPECT_EQ(within_current_limit(CurrentDisk<double>{{1.0, 0.0}, 1.0}, 5.0).radius_A, 1.0);
   EXPECT_EQ(within_current_limit(CurrentDisk<double>{{9.0, 0.0}, 1.0},
-                                 std::numeric_limits<double>::infinity()).radius_A, 1.0);
+                                 std::numeric_limits<double>::infinity())
+                .radius_A,
+            1.0);
 }
 
 }  // namespace

@@ -146,7 +146,8 @@ TEST_F(IolTest, AnUnreachableCommandKeepsTheFluxAndGivesUpTorque) {
     IolInput<double> in = operating_point(angle(rng), torque(rng), flux2(rng));
     const IolOutput<double> free = iol.step(in);
     ASSERT_FALSE(free.torque_limited);
-    const Vec2<double> flux_only = iol.step({in.flux_s_AB_Wb, in.i_s_AB_A, 0.0, in.y2_ref, {}}).i_next_AB_A;
+    const Vec2<double> flux_only =
+        iol.step({in.flux_s_AB_Wb, in.i_s_AB_A, 0.0, in.y2_ref, {}}).i_next_AB_A;
     // A disk around the flux-only command (on the line) that leaves out the full command.
     in.reach = {flux_only, share(rng) * (free.i_next_AB_A - flux_only).norm()};
     const IolOutput<double> out = iol.step(in);
