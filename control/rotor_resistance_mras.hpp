@@ -80,24 +80,35 @@ class RotorResistanceMras {
   const Vec2<T>& model_flux_AB_Wb() const noexcept { return flux_AB_Wb_; }
 
   /// One tick. `i_alphabeta_A`, `i_AB_A`: the current measured now (t_k) in the stator and the
-  /// rotor-aligned frame; `omega_mech_rad_s`: the speed now; `u_alphabeta_V`: the stator voltage
-  /// that acted over [t_{k-1}, t_k]; `adapt`: the drive runs a law (the estimate may move).
+  /// rotor-aligned frame; `omega_mech_rad_s`: the speed estimate now, for the frequency tests;
+  /// `omega_mean_rad_s`: the mean speed over [t_{k-1}, t_k] as measured (the encoder's counts
+  /// over the period), for Q^; `u_alphabeta_V`: the stator voltage that acted over
+  /// [t_{k-1}, t_k]; `adapt`: the drive runs a law (the estimate may move).
+  ///
+  /// Q^'s speed term is p w i.Psi^, so a speed off by dw makes Q^ off by dw / w_e: an estimate
+  /// that lags the rotor after a load step (its model expects the old load) by 8 rad/s at
+  /// 20 rad/s put 40 % into Q^ for 10 ms, which the filters held for a rotor time constant and
+  /// the estimate then adapted on (docs/robustness.md, "A measured speed"). The counts over the
+  /// period give its mean speed to one count, and the filters' average over tau_r, to one count
+  /// over tau_r.
   void step(const Vec2<T>& i_alphabeta_A, const Vec2<T>& i_AB_A, T omega_mech_rad_s,
-            const Vec2<T>& u_alphabeta_V, bool adapt) noexcept {
+            T omega_mean_rad_s, const Vec2<T>& u_alphabeta_V, bool adapt) noexcept {
     // The current model over [t_{k-1}, t_k], the current taken as its mean over the period.
     const T rho_T = Rr_Ohm_ * inv_Lr_ * period_s_;
     const T share = rho_T * (T(1) - rho_T * (T(0.5) - rho_T / T(6)));  // 1 - e^{-rho T}
     flux_AB_Wb_ += share * (Lm_H_ * T(0.5) * (i_AB_A + i_AB_last_A_) - flux_AB_Wb_);
-    const T q_adapt_now = Lm_over_Lr_ * (p_ * omega_mech_rad_s * i_AB_A.dot(flux_AB_Wb_) -
-                                         Rr_Ohm_ * inv_Lr_ * cross(i_AB_A, flux_AB_Wb_));
+    // Q^ over the period: i.Psi^ and i x Psi^ by the trapezoid, with the period's mean speed.
+    const T along_now = i_AB_A.dot(flux_AB_Wb_), across_now = cross(i_AB_A, flux_AB_Wb_);
+    const T q_adapt = Lm_over_Lr_ * T(0.5) *
+                      (p_ * omega_mean_rad_s * (along_now + along_last_) -
+                       Rr_Ohm_ * inv_Lr_ * (across_now + across_last_));
     const Vec2<T> i_mean_A = T(0.5) * (i_alphabeta_A + i_alphabeta_last_A_);
     const T q_ref =
         cross(i_mean_A, u_alphabeta_V) - sigma_over_T_ * cross(i_alphabeta_last_A_, i_alphabeta_A);
-    const T q_adapt = T(0.5) * (q_adapt_now + q_adapt_last_);
     q_ref_ += filter_ * (q_ref - q_ref_);
     q_adapt_ += filter_ * (q_adapt - q_adapt_);
-    along_ += filter_ * (flux_AB_Wb_.dot(i_AB_A) - along_);
-    across_ += filter_ * (cross(flux_AB_Wb_, i_AB_A) - across_);
+    along_ += filter_ * (along_now - along_);
+    across_ += filter_ * (-across_now - across_);  // Psi^ x i
     tangent_ = along_ > T(0) ? across_ / along_ : T(0);
     const T omega_e = p_ * omega_mech_rad_s + tangent_ * Rr_Ohm_ * inv_Lr_;
     // The filtered powers must also have been drawn above that frequency: in steady state
@@ -124,7 +135,8 @@ class RotorResistanceMras {
     }
     i_AB_last_A_ = i_AB_A;
     i_alphabeta_last_A_ = i_alphabeta_A;
-    q_adapt_last_ = q_adapt_now;
+    along_last_ = along_now;
+    across_last_ = across_now;
   }
 
   /// Carries the estimate and the filters over from the tracker of the model this one replaces
@@ -134,7 +146,8 @@ class RotorResistanceMras {
     flux_AB_Wb_ = old.flux_AB_Wb_;
     i_AB_last_A_ = old.i_AB_last_A_;
     i_alphabeta_last_A_ = old.i_alphabeta_last_A_;
-    q_adapt_last_ = old.q_adapt_last_;
+    along_last_ = old.along_last_;
+    across_last_ = old.across_last_;
     q_ref_ = old.q_ref_;
     q_adapt_ = old.q_adapt_;
     along_ = old.along_;
@@ -147,7 +160,7 @@ class RotorResistanceMras {
  private:
   void reset_filters() noexcept {
     flux_AB_Wb_ = i_AB_last_A_ = i_alphabeta_last_A_ = Vec2<T>::Zero();
-    q_adapt_last_ = q_ref_ = q_adapt_ = along_ = across_ = tangent_ = pending_ = T(0);
+    along_last_ = across_last_ = q_ref_ = q_adapt_ = along_ = across_ = tangent_ = pending_ = T(0);
   }
 
   /// a x b = a_x b_y - a_y b_x (the reactive power of a current and a voltage).
@@ -160,7 +173,8 @@ class RotorResistanceMras {
   T Rr_Ohm_;
   Vec2<T> flux_AB_Wb_ = Vec2<T>::Zero();
   Vec2<T> i_AB_last_A_ = Vec2<T>::Zero(), i_alphabeta_last_A_ = Vec2<T>::Zero();
-  T q_adapt_last_ = T(0), q_ref_ = T(0), q_adapt_ = T(0), along_ = T(0), across_ = T(0);
+  T along_last_ = T(0), across_last_ = T(0);  ///< i.Psi^ and i x Psi^ at t_{k-1}
+  T q_ref_ = T(0), q_adapt_ = T(0), along_ = T(0), across_ = T(0);
   T tangent_ = T(0);
   T pending_ = T(0);  ///< relative steps not yet applied to Rr_Ohm_
   bool adapting_ = false;

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 
 namespace imd::firmware {
 
@@ -45,6 +46,8 @@ Drive<T>::Drive(const std::optional<MotorRecord>& record, const DriveConfig& con
                   config.adc_calibration_ticks <= 0),
       clock_Hz_(peripherals.timer.execution_clock_Hz()),
       ns_per_count_(static_cast<float>(Real(1e9) / Real(clock_Hz_))),
+      rad_s_per_count_(T(2 * std::numbers::pi_v<Real> /
+                         (board_.encoder_counts_per_rev * config.sample_period_s))),
       limited_(limited_window_ticks(config)),
       brake_release_ticks_(duration_ticks(config.brake_release_time_s, config.sample_period_s)) {
   protection_.set_clock(clock_Hz_);
@@ -197,7 +200,8 @@ inline void Drive<T>::after_write(const Measurement<T>& m, const Estimate<T>& e,
   }
   if (tracker_due_) {
     tracker_due_ = false;
-    model->rotor_resistance.step(m.i_alphabeta_A, e.x.i_s_AB_A, e.x.omega_mech_rad_s, u_acted_V,
+    model->rotor_resistance.step(m.i_alphabeta_A, e.x.i_s_AB_A, e.x.omega_mech_rad_s,
+                                 T(m.encoder_delta_counts) * rad_s_per_count_, u_acted_V,
                                  tracker_adapts_);
   }
 }

@@ -188,6 +188,7 @@ class Drive final : public hal::TickHandler {
 
   uint32_t clock_Hz_;
   float ns_per_count_;               ///< execution-clock counts to ns
+  T rad_s_per_count_;  ///< an encoder count per period, as a mean speed over the period
   Vec2 v_applied_V_ = Vec2::Zero();  ///< rotor-frame input written this tick (zero if off)
   Vec2 u_last_period_V_ = Vec2::Zero();  ///< stator voltage that acted over [k-1, k]
   // Set before the PWM write for after_write (tick side).

@@ -68,6 +68,8 @@ struct DriveConfig {
   Real adc_offset_limit_A = 0.5;       ///< a larger measured offset is a fault
   Real magnetizing_current_A = 0.0;    ///< 0: sqrt(flux2_ref)/Lm, capped at 0.9 i_max
   Real magnetized_fraction = Real(0.95);  ///< running once |Phi^|^2 >= this * reference
+  /// The magnetizing timeout's floor: the timeout is twice the model's magnetizing time, at least
+  /// this (firmware/protection/magnetizing_timeout.hpp).
   Real magnetizing_timeout_s = 2.0;
 
   // Estimation.

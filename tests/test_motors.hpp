@@ -1,5 +1,6 @@
 #pragma once
-// The motors the tests run on: both papers' motors as shipped, and two more from tests/data.
+// The motors the tests run on: both papers' motors as shipped, and four more from tests/data
+// (0.55 to 37 kW, one to four pole pairs).
 // Each comes with magnitudes typical of its operation, used to draw random test states. The
 // files are read with toml++ here, so that a test of control/ links control/ alone (the
 // validated loader is hal_sim's, tested in tests/hal_sim/test_motor_file.cpp).
@@ -55,6 +56,10 @@ inline std::vector<TestMotor> test_motors() {
        300.0, 150.0, 4.0},
       {"six_pole_7kW", read_motor("tests/data/motors/six_pole_7kW.toml"), 0.9, 25.0, 300.0,
        100.0, 60.0},
+      {"two_pole_550W", read_motor("tests/data/motors/two_pole_550W.toml"), 0.8, 2.0, 300.0,
+       200.0, 1.0},
+      {"eight_pole_15kW", read_motor("tests/data/motors/eight_pole_15kW.toml"), 0.9, 40.0, 300.0,
+       60.0, 100.0},
   };
 }
 

@@ -8,6 +8,7 @@
 #include "control/voltage_fed_model.hpp"
 
 #include "firmware/duration_ticks.hpp"
+#include "firmware/protection/magnetizing_timeout.hpp"
 
 namespace imd::firmware {
 namespace {
@@ -73,6 +74,8 @@ MotorChecks<T>::MotorChecks(const control::MotorParameters& motor,
       torque_limit_Nm(T(config.torque_limit_Nm)),
       current_limit_A(T(config.current_margin * config.i_max_A)),
       per_Lm_H(T(1 / motor.Lm_H)),
+      magnetizing_timeout_ticks(saturated(
+          duration_ticks(magnetizing_timeout_s(motor, config), config.sample_period_s))),
       encoder(encoder_config<T>(motor, c, config, counts_per_rev)),
       adc_stuck(config.protection.adc_stuck_ticks, adc_A_per_code,
                 control::derive_voltage_fed(motor).sigma_H, config.sample_period_s),
@@ -89,8 +92,6 @@ Protection<T>::Protection(const DriveConfig& config) noexcept
       bus_min_V_(T(config.protection.bus_min_V)),
       bus_max_V_(T(config.protection.bus_max_V)),
       overspeed_rad_s_(T(config.protection.overspeed_rad_s)),
-      magnetizing_timeout_ticks_(
-          saturated(duration_ticks(config.magnetizing_timeout_s, config.sample_period_s))),
       command_timeout_ticks_(
           saturated(duration_ticks(config.protection.command_timeout_s, config.sample_period_s))) {}
 
@@ -119,7 +120,7 @@ Trip Protection<T>::check(const Measurement<T>& m, const Estimate<T>& e, const S
   }
   check_driving(m, e, s, *motor, trip);
   if (trip.any()) return trip;
-  if (s.magnetizing && s.magnetizing_ticks > magnetizing_timeout_ticks_) {
+  if (s.magnetizing && s.magnetizing_ticks > motor->magnetizing_timeout_ticks) {
     trip.add(FaultCode::magnetizing_timeout);
     return trip;
   }

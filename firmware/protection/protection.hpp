@@ -8,8 +8,8 @@
 ///      a non-finite estimate, the encoder;
 ///   4. while the inverter drives the motor (and nothing above tripped): bus under-voltage, a
 ///      stuck ADC, a lost phase, the command watchdog;
-///   5. then (nothing above tripped): the magnetizing timeout, a law without solution, a
-///      non-finite output.
+///   5. then (nothing above tripped): the magnetizing timeout (from the rotor time constant), a
+///      law without solution, a non-finite output.
 /// The tick's execution time is judged at its end (over_budget). Tick context except
 /// construction.
 #include <algorithm>
@@ -90,6 +90,8 @@ struct MotorChecks {
 
   T pole_pairs, torque_per_AWb;
   T max_load_share, torque_limit_Nm, current_limit_A, per_Lm_H;
+  /// Magnetizing longer than this is a fault (firmware/protection/magnetizing_timeout.hpp).
+  uint32_t magnetizing_timeout_ticks;
   EncoderCheck<T> encoder;
   AdcStuckCheck<T> adc_stuck;
   PhaseLossCheck<T> phase_loss;
@@ -120,7 +122,7 @@ class Protection {
   ProtectionConfig config_;
   bool commands_over_can_;
   T overcurrent_A_, bus_min_V_, bus_max_V_, overspeed_rad_s_;
-  uint32_t magnetizing_timeout_ticks_, command_timeout_ticks_;
+  uint32_t command_timeout_ticks_;
   uint32_t budget_counts_ = 0;
 };
 

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <numbers>
 
 #include "control/rotor_resistance_mras.hpp"
 #include "hal_sim/induction_motor_plant.hpp"
@@ -49,13 +50,20 @@ Outcome run_motor(const test::TestMotor& tm, double tangent, double scale, doubl
   config.sample_period_s = T;
   RotorResistanceMras<Real> mras(model, config, m.Rr_Ohm);
   V2 u_last = V2::Zero();
+  double theta_last_rad = start.theta_mech_rad;
   int adapting = 0;
   const int ticks = static_cast<int>(duration_s / T);
   for (int k = 0; k < ticks; ++k) {
     const sim::PlantState& s = plant.state();
     const Rotation<double> rotor = Rotation<double>::from_angle(m.pole_pairs * s.theta_mech_rad);
     const V2 i_AB = rotor.apply_inverse(s.i_s_alphabeta_A);
+    // The mean speed over the last period, as the encoder's counts give it (here exactly).
+    const double omega_mean =
+        k == 0 ? s.omega_mech_rad_s
+               : std::remainder(s.theta_mech_rad - theta_last_rad, 2 * std::numbers::pi) / T;
+    theta_last_rad = s.theta_mech_rad;
     mras.step(s.i_s_alphabeta_A.cast<Real>(), i_AB.cast<Real>(), Real(s.omega_mech_rad_s),
+              Real(omega_mean),
               u_last.cast<Real>(), true);
     adapting += mras.adapting();
     // The voltage for [t_k, t_k+1], taken at the middle of the period (as SVPWM holds it).
@@ -137,8 +145,9 @@ TEST(RotorResistanceMras, FloatFollowsDouble) {
     const V2 i_AB = Rotation<double>::from_angle(angle).apply(V2(i_d, i_d));
     const V2 i_ab = Rotation<double>::from_angle(theta).apply(i_AB);
     const V2 u = Rotation<double>::from_angle(theta + angle).apply(V2(10.0, 300.0));
-    single.step(i_ab.cast<float>(), i_AB.cast<float>(), float(omega), u.cast<float>(), true);
-    twice.step(i_ab, i_AB, omega, u, true);
+    single.step(i_ab.cast<float>(), i_AB.cast<float>(), float(omega), float(omega),
+                u.cast<float>(), true);
+    twice.step(i_ab, i_AB, omega, omega, u, true);
   }
   // float's 2^-24 on each product, accumulated through the filters: 1e-4 relative.
   EXPECT_NEAR(single.Rr_Ohm() / twice.Rr_Ohm(), 1.0, 1e-4);

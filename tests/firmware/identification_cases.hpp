@@ -2,7 +2,7 @@
 // The motors and boards the identification tests run on: a nameplate, and a board with
 // realistic sensors (ADC noise and per-phase offsets, 12 bits) and an inverter with dead time
 // and device drop. Paper 000's on a 311 V bus with a 10 A ADC, paper 001's 37 kW on 540 V with
-// a 250 A ADC, the 0.75 kW and 7 kW motors on 540 V with ADCs sized for them.
+// a 250 A ADC, the 0.55 kW, 0.75 kW, 7.5 kW and 15 kW motors on 540 V with ADCs sized for them.
 #include <gtest/gtest.h>
 
 #include <string>
@@ -28,6 +28,10 @@ inline const Case kSmall{
     "small_4pole_750W", {400.0, 1.9, 50.0, 2}, 540.0, 6.0, 10.0, 0.01, 0.02, 1e-6, 1.0};
 inline const Case kSixPole{
     "six_pole_7kW", {400.0, 14.0, 50.0, 3}, 540.0, 40.0, 50.0, 0.05, 0.1, 1.5e-6, 1.2};
+inline const Case kTwoPole{
+    "two_pole_550W", {400.0, 1.4, 50.0, 1}, 540.0, 5.0, 10.0, 0.01, 0.02, 1e-6, 1.0};
+inline const Case kEightPole{
+    "eight_pole_15kW", {400.0, 32.0, 50.0, 4}, 540.0, 80.0, 150.0, 0.15, 0.3, 2e-6, 1.5};
 
 inline sim::SimBoardConfig board_for(const Case& c, uint32_t encoder_cpr = 8192) {
   sim::SimBoardConfig b;

@@ -110,7 +110,8 @@ TEST_P(InertiaIdentification, InSinglePrecisionToo) {
 // The motors and boards of identification_cases.hpp (rotating_board: a 4096-count encoder).
 INSTANTIATE_TEST_SUITE_P(Motors, InertiaIdentification,
                          ::testing::Values(test_cases::kSeed000, test_cases::kSeed001,
-                                           test_cases::kSmall, test_cases::kSixPole),
+                                           test_cases::kSmall, test_cases::kSixPole,
+                                           test_cases::kTwoPole, test_cases::kEightPole),
                          test_cases::case_name);
 
 // A shaft that cannot turn in the test's time (here: a thousand times the inertia) is not an

@@ -41,7 +41,6 @@ struct Bench {
     config.protection.bus_min_V = 200.0;
     config.protection.bus_max_V = 450.0;
     config.protection.overspeed_rad_s = 400.0;
-    config.magnetizing_timeout_s = 0.01;  // 100 ticks
     m.valid = true;
     m.v_bus_V = 311.0;
     m.i_abc_A[0] = 1.0, m.i_abc_A[1] = -0.5, m.i_abc_A[2] = -0.5;
@@ -120,15 +119,25 @@ TEST(Protection, WhileCalibratingOnlyTheOffsetIsJudged) {
   EXPECT_EQ(t.bits, 1u << unsigned(FaultCode::adc_offset));
 }
 
-TEST(Protection, MagnetizingTimesOutAfterItsTicks) {
-  Bench b;
-  MotorProtection p = b.make();
-  b.s.magnetizing = true;
-  b.s.magnetizing_ticks = 100;
-  EXPECT_FALSE(p.check(b.m, b.e, b.s, b.law, b.out).any());
-  b.s.magnetizing_ticks = 101;
-  EXPECT_EQ(p.check(b.m, b.e, b.s, b.law, b.out).first,
-            FaultCode::magnetizing_timeout);
+TEST(Protection, MagnetizingTimesOutAfterTwiceTheRotorsMagnetizingTimeOrTheFloor) {
+  // The paper-000 motor: tau_r = Lr/Rr = 40.9 ms; under the current that holds the reference
+  // the squared flux reaches 0.95 of it in tau_r ln(1 / (1 - sqrt 0.95)) = 3.68 tau_r, 150 ms;
+  // twice that is 3 005 ticks at 100 us, below the 2 s floor. A floor of 0.1 s lets the
+  // motor's own time through.
+  const control::MotorParameters m = test::paper_motor();
+  const double derived_s = 2 * m.Lr_H / m.Rr_Ohm * std::log(1 / (1 - std::sqrt(0.95)));
+  for (const double floor_s : {2.0, 0.1}) {
+    Bench b;
+    b.config.magnetizing_timeout_s = floor_s;
+    MotorProtection p = b.make();
+    const auto ticks = uint32_t(std::ceil(std::max(floor_s, derived_s) / 1e-4));
+    EXPECT_EQ(p.motor.magnetizing_timeout_ticks, ticks) << floor_s;
+    b.s.magnetizing = true;
+    b.s.magnetizing_ticks = ticks;
+    EXPECT_FALSE(p.check(b.m, b.e, b.s, b.law, b.out).any());
+    b.s.magnetizing_ticks = ticks + 1;
+    EXPECT_EQ(p.check(b.m, b.e, b.s, b.law, b.out).first, FaultCode::magnetizing_timeout);
+  }
 }
 
 TEST(Protection, ALawWithoutSolutionTripsAfterItsWindowAndANonFiniteOutputAtOnce) {

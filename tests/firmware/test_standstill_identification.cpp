@@ -113,7 +113,8 @@ TEST_P(StandstillIdentification, InSinglePrecisionToo) {
 // scenarios have them).
 INSTANTIATE_TEST_SUITE_P(Motors, StandstillIdentification,
                          ::testing::Values(test_cases::kSeed000, test_cases::kSeed001,
-                                           test_cases::kSmall, test_cases::kSixPole),
+                                           test_cases::kSmall, test_cases::kSixPole,
+                                           test_cases::kTwoPole, test_cases::kEightPole),
                          test_cases::case_name);
 
 }  // namespace

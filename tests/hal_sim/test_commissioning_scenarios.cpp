@@ -1,5 +1,5 @@
-// The commissioning's acceptance on three motors (docs/identification.md): paper 000's, paper
-// 001's 37 kW and a four-pole 0.75 kW motor, each on a board with realistic sensors, dead time
+// The commissioning's acceptance on five motors (docs/identification.md): paper 000's, paper
+// 001's 37 kW, a four-pole 0.75 kW, a two-pole 0.55 kW and an eight-pole 15 kW motor, each on a board with realistic sensors, dead time
 // and device drop. hal_sim/scenarios/identify.toml runs the commissioning from the nameplate
 // alone; the identified motor file then drives the motor's realistic profile on the true plant.
 // Bounds: Rs 2 %, Ls 3 %, sigma Ls 5 %, tau_r 5 %, J 10 %; the speed RMS error on the
@@ -86,7 +86,8 @@ TEST_P(Commissioning, IdentifiesTheMotorAndRunsItsProfileAsWellAsTheTrueFile) {
 }
 
 // Boards: paper 000's motor on the identify scenario's own (311 V, 6 A, 10 A ADC); the 37 kW
-// on its realistic board (540 V, 150 A, 250 A ADC); the 0.75 kW on a 540 V board.
+// on its realistic board (540 V, 150 A, 250 A ADC); the 0.75 kW, 0.55 kW and 15 kW on 540 V boards
+// sized for them (as their realistic scenarios').
 INSTANTIATE_TEST_SUITE_P(
     Motors, Commissioning,
     ::testing::Values(
@@ -103,7 +104,21 @@ INSTANTIATE_TEST_SUITE_P(
               "nameplate.rated_voltage_V=400", "nameplate.rated_current_A=1.9",
               "nameplate.pole_pairs=2", "inverter.v_bus_V=540", "sensors.adc_bus_full_scale_V=1000",
               "sensors.adc_offset_A=0.02"},
-             "tests/data/scenarios/small_4pole_750W_realistic.toml"}),
+             "tests/data/scenarios/small_4pole_750W_realistic.toml"},
+        Case{"two_pole_550W",
+             {"plant.motor_file=\"../../tests/data/motors/two_pole_550W.toml\"",
+              "nameplate.rated_voltage_V=400", "nameplate.rated_current_A=1.4",
+              "nameplate.pole_pairs=1", "inverter.v_bus_V=540", "inverter.i_max_A=5",
+              "sensors.adc_bus_full_scale_V=1000", "sensors.adc_offset_A=0.02"},
+             "tests/data/scenarios/two_pole_550W_realistic.toml"},
+        Case{"eight_pole_15kW",
+             {"plant.motor_file=\"../../tests/data/motors/eight_pole_15kW.toml\"",
+              "nameplate.rated_voltage_V=400", "nameplate.rated_current_A=32",
+              "nameplate.pole_pairs=4", "inverter.v_bus_V=540", "inverter.i_max_A=80",
+              "sensors.adc_full_scale_A=150", "sensors.adc_noise_A=0.15",
+              "sensors.adc_offset_A=0.3", "sensors.adc_bus_full_scale_V=1000",
+              "inverter.dead_time_s=2e-6", "inverter.device_drop_V=1.5"},
+             "tests/data/scenarios/eight_pole_15kW_realistic.toml"}),
     [](const ::testing::TestParamInfo<Case>& p) { return std::string(p.param.name); });
 
 }  // namespace

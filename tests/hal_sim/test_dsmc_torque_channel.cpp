@@ -112,7 +112,9 @@ TEST(DsmcTorqueChannel, DoesNotRingOnTheOtherMotors) {
   // The 0.75 kW four-pole and the 7.5 kW six-pole motors: the paper's channel rings (0.09 A and
   // 2.4 A of control-rate ripple), the torque channel not (0.0007 A, 0.022 A): a tenth bounds it.
   for (const char* file : {"tests/data/scenarios/small_4pole_750W_realistic.toml",
-                           "tests/data/scenarios/six_pole_7kW_realistic.toml"}) {
+                           "tests/data/scenarios/six_pole_7kW_realistic.toml",
+                           "tests/data/scenarios/two_pole_550W_realistic.toml",
+                           "tests/data/scenarios/eight_pole_15kW_realistic.toml"}) {
     const Summary torque = run(file, {});
     const Summary paper = run(file, {"drive.dsmc_speed_channel=paper"});
     print(file, torque);

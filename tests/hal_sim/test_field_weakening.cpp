@@ -24,11 +24,14 @@ struct Case {
   double flux2_Wb2;  ///< the scenario's rotor-flux reference
 };
 
-// The paper's motor, a 0.75 kW 4-pole and a 7 kW 6-pole machine, each on its realistic board.
+// The paper's motor, a 0.75 kW 4-pole, a 7.5 kW 6-pole, a 0.55 kW 2-pole and a 15 kW 8-pole
+// machine, each on its realistic board.
 const Case kCases[] = {
     {"seed000", "hal_sim/scenarios/seed000_realistic.toml", 0.2},
     {"small_4pole_750W", "tests/data/scenarios/small_4pole_750W_realistic.toml", 0.5},
-    {"six_pole_7kW", "tests/data/scenarios/six_pole_7kW_realistic.toml", 0.6}};
+    {"six_pole_7kW", "tests/data/scenarios/six_pole_7kW_realistic.toml", 0.6},
+    {"two_pole_550W", "tests/data/scenarios/two_pole_550W_realistic.toml", 0.64},
+    {"eight_pole_15kW", "tests/data/scenarios/eight_pole_15kW_realistic.toml", 0.81}};
 
 struct Outcome {
   Summary summary;

@@ -14,33 +14,36 @@
 #include "hal_sim/law_variant.hpp"
 #include "hal_sim/scenario.hpp"
 #include "fault_events_text.hpp"
+#include "realistic_boards.hpp"
 #include "test_motors.hpp"
 
 namespace imd::sim {
 namespace {
 
-const char* const kBoards[] = {"hal_sim/scenarios/seed000_realistic.toml",
-                               "hal_sim/scenarios/seed001_realistic.toml",
-                               "tests/data/scenarios/small_4pole_750W_realistic.toml",
-                               "tests/data/scenarios/six_pole_7kW_realistic.toml"};
+const auto& kBoards = test_boards::kRealistic;
 
 double amps_per_code(const Scenario& s) {
   return 2.0 * s.adc.full_scale_A / double(1 << s.adc.bits);
 }
 
-// A profile no shipped scenario runs, on the board's motor: magnetized and held at standstill
-// (a DC current for 0.4 s), forward to 0.3 of base speed, a load step to 0.4 of the torque at
-// the current limit, then a slow reversal through zero speed under that load (the stator
-// frequency crosses zero while the rotor turns) to -0.2 of base speed.
+/// When the profile below starts: once the drive runs and has held the rotor at standstill (a
+/// DC current) for 0.4 s, and not before 0.6 s.
+double start_s(const Scenario& s) { return std::max(0.6, test_boards::running_by_s(s) + 0.4); }
+
+// A profile no shipped scenario runs, on the board's motor: magnetized and held at standstill,
+// forward to 0.3 of base speed, a load step to 0.4 of the torque at the current limit, then a
+// slow reversal through zero speed under that load (the stator frequency crosses zero while the
+// rotor turns) to -0.2 of base speed.
 Scenario quiet_profile(const char* file, const char* law, double noise_codes) {
   Scenario s = with_law(load_scenario(test::source_path(file)), law);
   const double w = base_speed_rad_s(s, s.flux2_Wb2);
   const double t = torque_at_current_limit_Nm(s, s.flux2_Wb2);
-  s.speed = speed_steps({{0.6, 0.3 * w}, {1.6, -0.2 * w}});
-  s.load = load_steps({{1.1, 0.4 * t}});
+  const double t0 = start_s(s);
+  s.speed = speed_steps({{t0, 0.3 * w}, {t0 + 1.0, -0.2 * w}});
+  s.load = load_steps({{t0 + 0.5, 0.4 * t}});
   s.max_accel_rad_s2 = w / 1.5;  // the reversal takes 0.75 s: slow through zero
   s.adc.noise_A = noise_codes * amps_per_code(s);
-  s.duration_s = 2.8;
+  s.duration_s = t0 + 2.2;
   return s;
 }
 
@@ -71,13 +74,15 @@ TEST(QuietAdcSweep, AQuietConverterNeverTripsTheStuckCheck) {
 
 TEST(QuietAdcSweep, AStuckQuietConverterIsStillFound) {
   // The other side: the same quiet converters (no noise at all, the hardest case for the
-  // evidence) freeze while the motor turns, at 0.9 s (running forward), 1.3 s (under load) and
-  // 2.0 s (reversing). Each is latched as adc_stuck within the run's 0.5 s after it.
+  // evidence) freeze while the motor turns, 0.3 s after the profile starts (running forward),
+  // 0.7 s (under load) and 1.4 s (reversing). Each is latched as adc_stuck within the run's
+  // 0.5 s after it.
   int runs = 0;
   for (const char* file : kBoards) {
     for (const char* law : {"dsmc", "ifoc", "iol"}) {
-      for (const double at_s : {0.9, 1.3, 2.0}) {
+      for (const double after_s : {0.3, 0.7, 1.4}) {
         Scenario s = quiet_profile(file, law, 0.0);
+        const double at_s = start_s(s) + after_s;
         FaultInjection f;
         f.at_s = at_s;
         f.kind = FaultKind::adc_stuck;
