@@ -1,5 +1,5 @@
 // The exact discretizations computed in float (control/float_discretization.cpp) against the
-// double reference, on every test motor (0.75 kW to 37 kW, one to three pole pairs), at the
+// double reference, on every test motor (0.55 kW to 37 kW, one to four pole pairs), at the
 // sample periods 50 us, 100 us and 1 ms and at rotor resistances 0.5x to 2x. Each coefficient
 // must be within the bound its header derives, relative to its own value.
 #include <gtest/gtest.h>

@@ -1,5 +1,5 @@
 // The whole commissioning on the simulated board, with the rotating step: inertia and viscous
-// friction identified on motors from 0.75 kW to 37 kW with realistic sensors and inverter.
+// friction identified on motors from 0.55 kW to 37 kW with realistic sensors and inverter.
 // Bound on J: the acceptance (10 %, docs/identification.md). J's error follows the torque's,
 // which follows tau_r's (bounded at 5 % by the standstill steps); the other half is left to
 // the encoder's and the current noise in the two rows. B: its error is J's relative error

@@ -1,4 +1,4 @@
-// The standstill identification on the simulated board, on motors from 0.75 kW to 37 kW, with
+// The standstill identification on the simulated board, on motors from 0.55 kW to 37 kW, with
 // realistic sensors (ADC noise, offset, 12 bits; a quantized encoder) and an inverter with dead
 // time and device drop: the identified Rs, Ls, sigma Ls and tau_r against the plant's, and the
 // rotor kept still. Bounds: the acceptance of docs/identification.md (Rs 2 %, Ls 3 %,

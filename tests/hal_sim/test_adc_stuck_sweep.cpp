@@ -57,7 +57,7 @@ TEST(AdcStuckSweep, AStuckAdcIsLatchedAsAdcStuckAtAnyTimeWithEveryLaw) {
 }
 
 TEST(AdcStuckSweep, BothFaultsKeepTheirCodesOnFourMotorsUnderAnUnshippedProfile) {
-  // The four motors (0.75 kW to the paper-001 machine, one to three pole pairs) on their
+  // The six motors (0.55 kW to the paper-001 37 kW machine, one to four pole pairs) on their
   // realistic boards with every law, under the phase-loss sweep's healthy profile, which no
   // shipped scenario runs: forward at 0.4 of base speed, a load step to half the torque at the
   // current limit, reversal to -0.3 of base speed against an overhauling quarter. A stuck ADC
@@ -91,7 +91,7 @@ TEST(AdcStuckSweep, BothFaultsKeepTheirCodesOnFourMotorsUnderAnUnshippedProfile)
       }
     }
   }
-  std::printf("four motors, unshipped profile: %d injections latched with their own codes\n",
+  std::printf("six motors, unshipped profile: %d injections latched with their own codes\n",
               runs);
 }
 

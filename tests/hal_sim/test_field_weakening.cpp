@@ -105,7 +105,7 @@ TEST_P(TwiceBaseSpeed, ReachesItOrSaysWhichLimitHoldsIt) {
 
 INSTANTIATE_TEST_SUITE_P(
     EveryLawEveryMotor, TwiceBaseSpeed,
-    testing::Combine(testing::Values(0, 1, 2),
+    testing::Combine(testing::Values(0, 1, 2, 3, 4),
                      testing::Values(std::string("dsmc"), std::string("iol"), std::string("ifoc"))),
     [](const testing::TestParamInfo<TwiceBaseSpeed::ParamType>& p) {
       return std::string(kCases[std::get<0>(p.param)].name) + "_" + std::get<1>(p.param);

@@ -1,5 +1,5 @@
 // Paper 001's law at the voltage limit on the simulated board: near base speed, under loads
-// that overhaul the motor, through a reversal, on four motors at the file's flux and at 0.6 of
+// that overhaul the motor, through a reversal, on six motors at the file's flux and at 0.6 of
 // it. The law commands only currents its loop reaches within a period (control/current_reach.hpp,
 // docs/iol.md "At the voltage limit"); before, a deceleration from 0.8 of base speed against
 // an overhauling load left it a command the loop could not deliver, its model drifted from the

@@ -1,7 +1,7 @@
 // The phase-loss check on the simulated board (firmware/protection/phase_loss_check.hpp): an
 // open phase injected at 30 times across the seed-000 realistic profile, each phase, with every
 // law, is found with the phase_loss code and the right phase; and no healthy run trips it, on
-// four motors with every law, at flux references and loads the shipped scenarios do not use,
+// six motors with every law, at flux references and loads the shipped scenarios do not use,
 // and on the paper scenarios at flux references and sample periods they do not use.
 #include <gtest/gtest.h>
 
@@ -59,7 +59,7 @@ TEST(PhaseLossSweep, AnOpenPhaseIsFoundAtAnyTimeWithEveryLaw) {
 }
 
 TEST(PhaseLossSweep, NoFalseTripOnAHealthyMotor) {
-  // Four motors (0.75 kW to the paper-001 machine, one to three pole pairs) on their realistic
+  // Six motors (0.55 kW to the paper-001 37 kW machine, one to four pole pairs) on their realistic
   // boards, with every law, at the file's flux and at 0.6 of it, under a profile no shipped
   // scenario runs: forward at 0.4 of base speed, a load step to half the torque at the current
   // limit, reversal to -0.3 of base speed against an overhauling quarter, standstill under a

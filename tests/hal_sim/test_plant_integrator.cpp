@@ -1,6 +1,6 @@
 // The plant's sixth-order integrator (hal_sim/plant_integrator.hpp) against RK4 at 10 us, the
-// integrator every earlier result was computed with: on the four motors of the tests (0.5 to
-// 37 kW, one to three pole pairs), in each input mode the sixth-order method serves (held
+// integrator every earlier result was computed with: on the six motors of the tests (0.55 to
+// 37 kW, one to four pole pairs), in each input mode the sixth-order method serves (held
 // voltages as the inverter's average, the analog feedback (2), the PWM off), with load steps,
 // from rest and at field-weakening speeds.
 //

@@ -48,7 +48,7 @@ Scenario quiet_profile(const char* file, const char* law, double noise_codes) {
 }
 
 TEST(QuietAdcSweep, AQuietConverterNeverTripsTheStuckCheck) {
-  // Four motors (0.75 kW to the paper-001 machine, one to three pole pairs), every law, the
+  // Six motors (0.55 kW to the paper-001 37 kW machine, one to four pole pairs), every law, the
   // converter's noise from none to a third of a code rms (beyond that the codes rarely
   // repeat on all three phases), on the shipped realistic profile and on the one above: no
   // fault at all.
