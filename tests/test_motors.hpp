@@ -52,12 +52,12 @@ inline std::vector<TestMotor> test_motors() {
   return {
       {"seed000", read_motor("hal_sim/motors/seed000.toml"), 0.5, 3.0, 300.0, 250.0, 1.0},
       {"seed001", read_motor("hal_sim/motors/seed001.toml"), 1.0, 200.0, 300.0, 150.0, 200.0},
-      {"small_4pole_750W", read_motor("tests/data/motors/small_4pole_750W.toml"), 0.8, 2.0,
-       300.0, 150.0, 4.0},
-      {"six_pole_7kW", read_motor("tests/data/motors/six_pole_7kW.toml"), 0.9, 25.0, 300.0,
-       100.0, 60.0},
-      {"two_pole_550W", read_motor("tests/data/motors/two_pole_550W.toml"), 0.8, 2.0, 300.0,
-       200.0, 1.0},
+      {"small_4pole_750W", read_motor("tests/data/motors/small_4pole_750W.toml"), 0.8, 2.0, 300.0,
+       150.0, 4.0},
+      {"six_pole_7kW", read_motor("tests/data/motors/six_pole_7kW.toml"), 0.9, 25.0, 300.0, 100.0,
+       60.0},
+      {"two_pole_550W", read_motor("tests/data/motors/two_pole_550W.toml"), 0.8, 2.0, 300.0, 200.0,
+       1.0},
       {"eight_pole_15kW", read_motor("tests/data/motors/eight_pole_15kW.toml"), 0.9, 40.0, 300.0,
        60.0, 100.0},
   };

@@ -74,8 +74,8 @@ MotorChecks<T>::MotorChecks(const control::MotorParameters& motor,
       torque_limit_Nm(T(config.torque_limit_Nm)),
       current_limit_A(T(config.current_margin * config.i_max_A)),
       per_Lm_H(T(1 / motor.Lm_H)),
-      magnetizing_timeout_ticks(saturated(
-          duration_ticks(magnetizing_timeout_s(motor, config), config.sample_period_s))),
+      magnetizing_timeout_ticks(
+          saturated(duration_ticks(magnetizing_timeout_s(motor, config), config.sample_period_s))),
       encoder(encoder_config<T>(motor, c, config, counts_per_rev)),
       adc_stuck(config.protection.adc_stuck_ticks, adc_A_per_code,
                 control::derive_voltage_fed(motor).sigma_H, config.sample_period_s),

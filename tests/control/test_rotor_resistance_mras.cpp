@@ -63,8 +63,7 @@ Outcome run_motor(const test::TestMotor& tm, double tangent, double scale, doubl
                : std::remainder(s.theta_mech_rad - theta_last_rad, 2 * std::numbers::pi) / T;
     theta_last_rad = s.theta_mech_rad;
     mras.step(s.i_s_alphabeta_A.cast<Real>(), i_AB.cast<Real>(), Real(s.omega_mech_rad_s),
-              Real(omega_mean),
-              u_last.cast<Real>(), true);
+              Real(omega_mean), u_last.cast<Real>(), true);
     adapting += mras.adapting();
     // The voltage for [t_k, t_k+1], taken at the middle of the period (as SVPWM holds it).
     const Rotation<double> frame = Rotation<double>::from_angle(omega_e * (k + 0.5) * T);
@@ -145,8 +144,8 @@ TEST(RotorResistanceMras, FloatFollowsDouble) {
     const V2 i_AB = Rotation<double>::from_angle(angle).apply(V2(i_d, i_d));
     const V2 i_ab = Rotation<double>::from_angle(theta).apply(i_AB);
     const V2 u = Rotation<double>::from_angle(theta + angle).apply(V2(10.0, 300.0));
-    single.step(i_ab.cast<float>(), i_AB.cast<float>(), float(omega), float(omega),
-                u.cast<float>(), true);
+    single.step(i_ab.cast<float>(), i_AB.cast<float>(), float(omega), float(omega), u.cast<float>(),
+                true);
     twice.step(i_ab, i_AB, omega, omega, u, true);
   }
   // float's 2^-24 on each product, accumulated through the filters: 1e-4 relative.

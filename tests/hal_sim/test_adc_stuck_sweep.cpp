@@ -56,7 +56,7 @@ TEST(AdcStuckSweep, AStuckAdcIsLatchedAsAdcStuckAtAnyTimeWithEveryLaw) {
   }
 }
 
-TEST(AdcStuckSweep, BothFaultsKeepTheirCodesOnFourMotorsUnderAnUnshippedProfile) {
+TEST(AdcStuckSweep, BothFaultsKeepTheirCodesOnEveryMotorUnderAnUnshippedProfile) {
   // The six motors (0.55 kW to the paper-001 37 kW machine, one to four pole pairs) on their
   // realistic boards with every law, under the phase-loss sweep's healthy profile, which no
   // shipped scenario runs: forward at 0.4 of base speed, a load step to half the torque at the
@@ -91,8 +91,7 @@ TEST(AdcStuckSweep, BothFaultsKeepTheirCodesOnFourMotorsUnderAnUnshippedProfile)
       }
     }
   }
-  std::printf("six motors, unshipped profile: %d injections latched with their own codes\n",
-              runs);
+  std::printf("six motors, unshipped profile: %d injections latched with their own codes\n", runs);
 }
 
 }  // namespace

@@ -1,9 +1,9 @@
 // The commissioning's acceptance on five motors (docs/identification.md): paper 000's, paper
-// 001's 37 kW, a four-pole 0.75 kW, a two-pole 0.55 kW and an eight-pole 15 kW motor, each on a board with realistic sensors, dead time
-// and device drop. hal_sim/scenarios/identify.toml runs the commissioning from the nameplate
-// alone; the identified motor file then drives the motor's realistic profile on the true plant.
-// Bounds: Rs 2 %, Ls 3 %, sigma Ls 5 %, tau_r 5 %, J 10 %; the speed RMS error on the
-// identified file within 1.2 times that on the true file.
+// 001's 37 kW, a four-pole 0.75 kW, a two-pole 0.55 kW and an eight-pole 15 kW motor, each on a
+// board with realistic sensors, dead time and device drop. hal_sim/scenarios/identify.toml runs the
+// commissioning from the nameplate alone; the identified motor file then drives the motor's
+// realistic profile on the true plant. Bounds: Rs 2 %, Ls 3 %, sigma Ls 5 %, tau_r 5 %, J 10 %; the
+// speed RMS error on the identified file within 1.2 times that on the true file.
 #include <gtest/gtest.h>
 
 #include <cmath>

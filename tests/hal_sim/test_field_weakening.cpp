@@ -1,5 +1,5 @@
 // Above base speed (docs/control.md, "Field weakening" and "Limited"): a step to twice the base
-// speed, with each law on three motors, either reaches its reference or the drive reports
+// speed, with each law on five motors, either reaches its reference or the drive reports
 // `limited` with the reason until the end; and it never claims a limit once there. No faults,
 // the flux stays positive and the current within its limit. The base speed and the torque
 // limit follow from the motor and the board, not from the scenario's profile.
@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iterator>
 #include <string>
 #include <vector>
 
@@ -103,13 +104,14 @@ TEST_P(TwiceBaseSpeed, ReachesItOrSaysWhichLimitHoldsIt) {
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(
-    EveryLawEveryMotor, TwiceBaseSpeed,
-    testing::Combine(testing::Values(0, 1, 2, 3, 4),
-                     testing::Values(std::string("dsmc"), std::string("iol"), std::string("ifoc"))),
-    [](const testing::TestParamInfo<TwiceBaseSpeed::ParamType>& p) {
-      return std::string(kCases[std::get<0>(p.param)].name) + "_" + std::get<1>(p.param);
-    });
+INSTANTIATE_TEST_SUITE_P(EveryLawEveryMotor, TwiceBaseSpeed,
+                         testing::Combine(testing::Range(0, int(std::size(kCases))),
+                                          testing::Values(std::string("dsmc"), std::string("iol"),
+                                                          std::string("ifoc"))),
+                         [](const testing::TestParamInfo<TwiceBaseSpeed::ParamType>& p) {
+                           return std::string(kCases[std::get<0>(p.param)].name) + "_" +
+                                  std::get<1>(p.param);
+                         });
 
 }  // namespace
 }  // namespace imd::sim

@@ -56,7 +56,8 @@ TEST(MagnetizingSweep, EveryMotorMagnetizesWithinItsTimeoutWhateverItsRotor) {
   double worst_share = 0.0;
   for (const char* file : test_boards::kRealistic) {
     for (const char* law : kLaws) {
-      for (const Rotor rotor : {Rotor{1.0, 1.0}, Rotor{1.0, 0.5}, Rotor{1.0, 1.5}, Rotor{0.5, 0.5}}) {
+      for (const Rotor rotor :
+           {Rotor{1.0, 1.0}, Rotor{1.0, 0.5}, Rotor{1.0, 1.5}, Rotor{0.5, 0.5}}) {
         Scenario s = at_rest(file, law);
         s.plant.Rr_Ohm = rotor.plant_scale * s.motor.Rr_Ohm;
         s.motor.Rr_Ohm *= rotor.record_scale;

@@ -10,10 +10,10 @@
 #include <cstdio>
 #include <string>
 
+#include "fault_events_text.hpp"
 #include "hal_sim/drive/scenario_run.hpp"
 #include "hal_sim/law_variant.hpp"
 #include "hal_sim/scenario.hpp"
-#include "fault_events_text.hpp"
 #include "realistic_boards.hpp"
 #include "test_motors.hpp"
 
@@ -28,7 +28,9 @@ double amps_per_code(const Scenario& s) {
 
 /// When the profile below starts: once the drive runs and has held the rotor at standstill (a
 /// DC current) for 0.4 s, and not before 0.6 s.
-double start_s(const Scenario& s) { return std::max(0.6, test_boards::running_by_s(s) + 0.4); }
+double start_s(const Scenario& s) {
+  return std::max(0.6, test_boards::running_by_s(s) + 0.4);
+}
 
 // A profile no shipped scenario runs, on the board's motor: magnetized and held at standstill,
 // forward to 0.3 of base speed, a load step to 0.4 of the torque at the current limit, then a

@@ -67,8 +67,7 @@ Scenario reversal(const char* file, const char* law, double period_s, double rr_
   // From the first crossing whose load step comes once the drive runs: a load on a rotor not
   // yet magnetized turns it, and a slow rotor (the 15 kW's, cold: 2.2 s) may take several
   // half periods to magnetize.
-  const int first =
-      std::max(1, int(std::ceil((test_boards::running_by_s(s) - shift_s) / half_s)));
+  const int first = std::max(1, int(std::ceil((test_boards::running_by_s(s) - shift_s) / half_s)));
   for (int k = first; k < first + 4; ++k) {  // high after the 1st and 3rd, none after the others
     s.load.times_s[s.load.step_count] = k * half_s + shift_s;
     s.load.values_Nm[s.load.step_count++] = ((k - first) % 2 == 0) ? 0.4 * t_lim : 0.0;

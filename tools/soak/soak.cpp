@@ -44,7 +44,7 @@ int main(int argc, char** argv) {
   std::string scenario_file =  // installed beside soak, or in the source tree
       imd::tools::data_file("scenarios/seed000_can.toml", "hal_sim/scenarios/seed000_can.toml");
   std::string law = "dsmc", precision = "double";
-  double seconds = 60.0, brake_Nm = 5.0;
+  double seconds = 60.0, brake_Nm = -1.0;  // -1: sized from the motor and the board (below)
   uint64_t seed = 1;
   app.add_option("--scenario", scenario_file, "A CAN-commanded scenario file (the board)")
       ->check(CLI::ExistingFile);
@@ -53,7 +53,8 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"double", "float"}));
   app.add_option("--seconds", seconds, "Simulated time")->check(CLI::Range(1.0, 1e6));
   app.add_option("--seed", seed, "Seed of the host, the faults and the ADC noise");
-  app.add_option("--brake-Nm", brake_Nm, "Holding brake fitted (0: none)")
+  app.add_option("--brake-Nm", brake_Nm,
+                 "Holding brake fitted (0: none; default: the torque at the current limit)")
       ->check(CLI::NonNegativeNumber);
   CLI11_PARSE(app, argc, argv);
 
@@ -75,7 +76,10 @@ int main(int argc, char** argv) {
   }
   s.can_commands.clear();  // the soak host is the host
   s.faults.clear();
-  s.brake.holding_torque_Nm = brake_Nm;
+  // The host's loads reach half the torque at the current limit, either sign; a brake of the
+  // whole of it holds them when the drive is off. Without one such a load runs the free rotor
+  // up to over-speed (on the 15 kW test motor, from 0.8 of base speed, in about a second).
+  s.brake.holding_torque_Nm = brake_Nm >= 0.0 ? brake_Nm : s.torque_limit_Nm;
   // Host time is not the MCU's: only a stall trips it. 1 s, because a loaded machine preempts a
   // tick for 100 ms and more; the injected stall (soak_host.cpp) is 2.5 times it.
   s.protection.tick_budget_us = 1e6;
