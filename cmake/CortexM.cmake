@@ -1,8 +1,10 @@
 # Firmware images for Cortex-M4F targets.
 #
 # imd_add_cortex_m_image(NAME LINKER_SCRIPT script [TICK_ROOTS sym...] [NO_DOUBLE]
+#                        [FLASH_BUDGET bytes] [RAM_BUDGET bytes]
 #                        [STACK_LEVELS handlers...] SOURCES src... LIBRARIES lib...)
-# links NAME.elf with the target's linker script and writes NAME.map, NAME.size.txt, and the
+# links NAME.elf with the target's linker script (which asserts the budgets, when it has them)
+# and writes NAME.map, NAME.size.txt, and the
 # flashable NAME.bin (raw, from the first flash address) and NAME.hex (Intel HEX). The
 # link itself refuses exceptions: every throw entry point is wrapped (--wrap) and the wrappers
 # are never defined, so a reference fails with "undefined reference to `__wrap___cxa_throw'".
@@ -31,8 +33,8 @@ find_program(IMD_ARM_SIZE arm-none-eabi-size REQUIRED)
 find_program(IMD_ARM_OBJCOPY arm-none-eabi-objcopy REQUIRED)
 
 function(imd_add_cortex_m_image NAME)
-  cmake_parse_arguments(ARG "NO_DOUBLE" "LINKER_SCRIPT" "TICK_ROOTS;STACK_LEVELS;SOURCES;LIBRARIES"
-                        ${ARGN})
+  cmake_parse_arguments(ARG "NO_DOUBLE" "LINKER_SCRIPT;FLASH_BUDGET;RAM_BUDGET"
+                        "TICK_ROOTS;STACK_LEVELS;SOURCES;LIBRARIES" ${ARGN})
   add_executable(${NAME} ${ARG_SOURCES})
   set_target_properties(${NAME} PROPERTIES SUFFIX ".elf")
   target_link_libraries(${NAME} PRIVATE ${ARG_LIBRARIES} imd_hal_cortex_m imd_cortex_m_runtime)
@@ -45,6 +47,13 @@ function(imd_add_cortex_m_image NAME)
                       "LINKER:-Map=$<TARGET_FILE_DIR:${NAME}>/${NAME}.map"
                       ${wraps})
   set_property(TARGET ${NAME} APPEND PROPERTY LINK_DEPENDS ${ARG_LINKER_SCRIPT})
+  # Budgets below the chip's regions, which the linker script asserts (bytes).
+  if(ARG_FLASH_BUDGET)
+    target_link_options(${NAME} PRIVATE "LINKER:--defsym=IMD_FLASH_BUDGET=${ARG_FLASH_BUDGET}")
+  endif()
+  if(ARG_RAM_BUDGET)
+    target_link_options(${NAME} PRIVATE "LINKER:--defsym=IMD_RAM_BUDGET=${ARG_RAM_BUDGET}")
+  endif()
   add_custom_command(TARGET ${NAME} POST_BUILD
     COMMAND ${IMD_ARM_SIZE} $<TARGET_FILE:${NAME}> > $<TARGET_FILE_DIR:${NAME}>/${NAME}.size.txt
     VERBATIM)

@@ -127,12 +127,16 @@ void Drive<T>::release_model() noexcept {
 
 template <typename T>
 Modulation<T> Drive<T>::identify(const Measurement<T>& m) noexcept {
-  if (!m.valid || !identifier_) return {};
-  const Modulation<T> out = direct_modulation(
-      identifier_->step(m.i_alphabeta_A, m.encoder_delta_counts), m.v_bus_V);
-  supervisor_.identification_progress(identifier_->step_code(),
-                                      static_cast<float>(identifier_->fraction()));
-  return out;
+  if constexpr (kCommissioningInImage) {
+    if (!m.valid || !identifier_) return {};
+    const Modulation<T> out = direct_modulation(
+        identifier_->step(m.i_alphabeta_A, m.encoder_delta_counts), m.v_bus_V);
+    supervisor_.identification_progress(identifier_->step_code(),
+                                        static_cast<float>(identifier_->fraction()));
+    return out;
+  } else {
+    return {};  // never identifying: the supervisor refuses the command (not_in_image)
+  }
 }
 
 template <typename T>
@@ -150,23 +154,25 @@ Modulation<T> Drive<T>::dc_brake(const Measurement<T>& m, const Estimate<T>& e,
 
 template <typename T>
 void Drive<T>::end_identification(uint64_t k) noexcept {
-  if (adopt_pending_) {  // a parameter read was in flight at the end: hand over now
+  if constexpr (kCommissioningInImage) {
+    if (adopt_pending_) {  // a parameter read was in flight at the end: hand over now
+      adopt_pending_ = !bank_.submit({protocol::ParameterOp::identified, 0, 0.0f, true});
+      return;
+    }
+    if (supervisor_.state() != DriveState::identifying || !identifier_ ||
+        !identifier_->finished()) {
+      return;
+    }
+    const bool done = identifier_->succeeded();
+    supervisor_.identification_ended(k, done, identifier_->failure_code());
+    pwm_off();
+    if (!done) return;
+    // The new record replaces the model: the service loop builds it from the result.
+    attached_ = nullptr;
+    supervisor_.attach(nullptr, nullptr, k);
+    model_ready_.store(false, std::memory_order_relaxed);
     adopt_pending_ = !bank_.submit({protocol::ParameterOp::identified, 0, 0.0f, true});
-    return;
   }
-  if (supervisor_.state() != DriveState::identifying || !identifier_ ||
-      !identifier_->finished()) {
-    return;
-  }
-  const bool done = identifier_->succeeded();
-  supervisor_.identification_ended(k, done, identifier_->failure_code());
-  pwm_off();
-  if (!done) return;
-  // The new record replaces the model: the service loop builds it from the result.
-  attached_ = nullptr;
-  supervisor_.attach(nullptr, nullptr, k);
-  model_ready_.store(false, std::memory_order_relaxed);
-  adopt_pending_ = !bank_.submit({protocol::ParameterOp::identified, 0, 0.0f, true});
 }
 
 template <typename T>

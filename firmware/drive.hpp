@@ -13,12 +13,15 @@
 #include <atomic>
 #include <cstdint>
 #include <optional>
+#include <type_traits>
+#include <variant>
 
 #include "control/motor_parameters.hpp"
 #include "control/voltage_fed_model.hpp"
 #include "firmware/drive_config.hpp"
 #include "firmware/drive_state.hpp"
 #include "firmware/execution_stats.hpp"
+#include "firmware/image_features.hpp"
 #include "firmware/identification/commissioning.hpp"
 #include "firmware/laws/law_registry.hpp"
 #include "firmware/limitation.hpp"
@@ -179,8 +182,10 @@ class Drive final : public hal::TickHandler {
   uint32_t last_retune_tick_ = 0;
   uint32_t retunes_ = 0;
   bool tracking_;  ///< the tracker may move Rr (config, and a power stage that knows its voltage)
-  /// Planned by the service loop on an identify command, then run by the tick.
-  std::optional<Commissioning<T>> identifier_;
+  /// Planned by the service loop on an identify command, then run by the tick; nothing in an
+  /// image without the commissioning (firmware/image_features.hpp).
+  std::conditional_t<kCommissioningInImage, std::optional<Commissioning<T>>, std::monostate>
+      identifier_;
   bool adopt_pending_ = false;  ///< its result still waits for the bank (tick side)
   Protection<T> protection_;
   Telemetry telemetry_;

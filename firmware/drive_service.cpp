@@ -12,13 +12,17 @@ template <typename T>
 void Drive<T>::service() noexcept {
   switch (bank_.stage()) {
     case ParameterBank::Stage::access:
-      if (bank_.access().op == protocol::ParameterOp::identify) {
-        plan_commissioning();
-      } else if (bank_.access().op == protocol::ParameterOp::identified) {
-        adopt_commissioning();
-      } else {
-        bank_.serve(hw_.store);
+      if constexpr (kCommissioningInImage) {
+        if (bank_.access().op == protocol::ParameterOp::identify) {
+          plan_commissioning();
+          return;
+        }
+        if (bank_.access().op == protocol::ParameterOp::identified) {
+          adopt_commissioning();
+          return;
+        }
       }
+      bank_.serve(hw_.store);  // without the commissioning, the supervisor sends no identify
       return;
     case ParameterBank::Stage::apply:
       // The tick let go of the model before it asked: it is the service loop's to rebuild.

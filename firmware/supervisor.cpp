@@ -29,7 +29,9 @@ Supervisor<T>::Supervisor(const DriveConfig& config, const SupervisorWiring& wir
       laws_(laws),
       magnetizer_(magnetizer),
       predicts_latency_(predicts_latency),
-      controller_(config.controller),
+      // Only a board's own compiled-in config could name a law outside its image, and the
+      // board's build sets it from the image (board_config.hpp).
+      controller_(law_in_image(config.controller) ? config.controller : first_law_in_image()),
       decoder_(config.node_id, {float(config.protection.overspeed_rad_s),
                                 float(config.min_flux2_command_Wb2), float(config.max_flux2_Wb2)}),
       ramp_(config.max_accel_rad_s2, config.sample_period_s),
@@ -43,7 +45,7 @@ Supervisor<T>::Supervisor(const DriveConfig& config, const SupervisorWiring& wir
       calibrated_(calibrated),
       record_complete_(laws != nullptr),
       record_saved_(laws != nullptr) {
-  select(config.controller);
+  select(controller_);
   if (calibrated_) {
     machine_.go(rest_state(), TransitionReason::calibrated, 0);
     TickPlan<T> unused;

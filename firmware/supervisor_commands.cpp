@@ -21,7 +21,7 @@ void Supervisor<T>::receive_commands(uint64_t k, TickPlan<T>& p) noexcept {
     if (d.result == protocol::CommandResult::accepted) {
       last_command_tick_ = k;  // any valid command feeds the watchdog
       d.result = apply(d.command, k, p);
-      if (d.result == protocol::CommandResult::not_allowed) decoder_.count_not_allowed();
+      if (d.result != protocol::CommandResult::accepted) decoder_.count_refused(d.result);
     }
     wiring_.telemetry.acknowledge(*wiring_.can, d, decoder_.rejected_total());
   }
@@ -105,6 +105,7 @@ protocol::CommandResult Supervisor<T>::apply(const protocol::Command& c, uint64_
       const long index = std::lround(c.value);
       if (index < 0 || index >= kControllerCount) return CommandResult::out_of_range;
       const auto wanted = static_cast<ControllerKind>(index);
+      if (!law_in_image(wanted)) return CommandResult::not_in_image;
       if (laws_ == nullptr) return CommandResult::not_allowed;  // no motor model
       // Only at rest; a law that follows no speed reference only with references of its own.
       const bool speed_capable = laws_->law(wanted).follows_speed() || !commands_over_can_;
@@ -119,6 +120,7 @@ protocol::CommandResult Supervisor<T>::apply(const protocol::Command& c, uint64_
     case CommandKind::parameter_access:
       return access_parameter(c, k, p);
     case CommandKind::identify: {
+      if (!kCommissioningInImage) return CommandResult::not_in_image;
       // Planned from the record's nameplate by the service loop (Drive::service); running
       // once it answers.
       const bool at_rest = s == DriveState::idle || s == DriveState::unconfigured;

@@ -12,6 +12,7 @@
 #include <algorithm>
 #include <array>
 #include <cstdint>
+#include <iterator>
 
 #include "firmware/protocol/messages.hpp"
 #include "hal/can_bus.hpp"
@@ -53,8 +54,11 @@ enum class CommandResult : uint8_t {
   out_of_range,
   not_allowed,  ///< valid, but not in the drive's present state (set by the application)
   unknown_message,
+  not_in_image,  ///< a law or the commissioning that this firmware image does not carry
 };
-inline constexpr int kCommandResultCount = 8;
+inline constexpr int kCommandResultCount = 9;
+static_assert(std::size(kCommandResultValues) == kCommandResultCount,
+              "every command result has its name in the protocol's value table");
 
 /// Largest accepted counter step: up to two lost frames in a row.
 inline constexpr uint8_t kMaxCounterStep = 3;
@@ -91,9 +95,10 @@ class CommandDecoder {
   /// Checks a frame and, if it is a valid command for this node, advances the counter.
   Decoded decode(const hal::CanFrame& frame) noexcept;
 
-  /// A command the application refuses in its present state: counted like a rejection.
-  void count_not_allowed() noexcept {
-    ++rejections_[int(CommandResult::not_allowed)];
+  /// A command the application refuses (not allowed now, a value it cannot take, not in this
+  /// image): counted like a rejection. `reason` is not `accepted`.
+  void count_refused(CommandResult reason) noexcept {
+    ++rejections_[int(reason)];
     ++rejected_total_;
   }
 

@@ -39,6 +39,7 @@ inline constexpr ValueName kLimitedValues[] = {
 inline constexpr ValueName kCommandResultValues[] = {
     {0, "accepted"},      {1, "wrong_length"}, {2, "bad_crc"},     {3, "repeated_counter"},
     {4, "stale_counter"}, {5, "out_of_range"}, {6, "not_allowed"}, {7, "unknown_message"},
+    {8, "not_in_image"},
 };
 inline constexpr ValueName kTransitionReasonValues[] = {
     {0, "calibrated"}, {1, "enable"}, {2, "magnetized"},   {3, "disable"},

@@ -137,7 +137,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     }
     if ((flags & 8) != 0 && d.result == CommandResult::accepted) {
       const uint32_t before = decoder.rejected_total();
-      decoder.count_not_allowed();
+      decoder.count_refused(CommandResult::not_allowed);
       FUZZ_CHECK(decoder.rejected_total() == before + 1);
     }
   }

@@ -8,6 +8,7 @@
 #include "control/motor_parameters.hpp"
 #include "control/real.hpp"
 #include "firmware/drive_config.hpp"
+#include "firmware/image_features.hpp"
 #include "firmware/protocol/messages.hpp"
 #include "hal/cortex_m/stm32g4/adc_injected.hpp"
 #include "hal/cortex_m/stm32g4/adc_tick.hpp"
@@ -106,7 +107,7 @@ inline constexpr std::array<g4::PinConfig, 11> kOtherPins{{
 constexpr DriveConfig drive_config() {
   DriveConfig c;
   c.sample_period_s = Real(kControlPeriod_ns * 1e-9);
-  c.controller = ControllerKind::dsmc;
+  c.controller = first_law_in_image();  // the run image's one law (docs/flashing.md)
   c.pwm_latency_ticks = 1;  // duties act from the next carrier peak (tim1_pwm.hpp)
   c.compensate_latency = true;
   c.speed_reaching_pole = Real(0.98);

@@ -13,7 +13,7 @@ class CommandRejected(DriveError):
     """The drive answered a command with a command_ack whose result is not `accepted`.
 
     `result` is the result's name (wrong_length, bad_crc, repeated_counter, stale_counter,
-    out_of_range, not_allowed, unknown_message; docs/can/protocol.md)."""
+    out_of_range, not_allowed, unknown_message, not_in_image; docs/can/protocol.md)."""
 
     def __init__(self, text, message_name, counter, result):
         super().__init__(text)

@@ -41,7 +41,8 @@ MESSAGE_VALUES = ((1, "emergency_stop"), (2, "heartbeat"), (3, "fault_report"), 
     (19, "timing"), (20, "stage_timing_1"), (21, "stage_timing_2"), (22, "identify_progress"),
     (23, "version"),)
 RESULT_VALUES = ((0, "accepted"), (1, "wrong_length"), (2, "bad_crc"), (3, "repeated_counter"),
-    (4, "stale_counter"), (5, "out_of_range"), (6, "not_allowed"), (7, "unknown_message"),)
+    (4, "stale_counter"), (5, "out_of_range"), (6, "not_allowed"), (7, "unknown_message"),
+    (8, "not_in_image"),)
 REASON_VALUES = ((0, "calibrated"), (1, "enable"), (2, "magnetized"), (3, "disable"),
     (4, "stopped"), (5, "fault"), (6, "clear_faults"), (7, "shutdown"), (8, "parameters_written"),
     (9, "configured"), (10, "identify"), (11, "identified"), (12, "identification_failed"),)
