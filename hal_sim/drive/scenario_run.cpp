@@ -148,6 +148,7 @@ Summary run(const Scenario& s, const RunCallbacks& callbacks) {
   const RunMetrics& metrics = observer.metrics();
   summary.speed_rms_err_rad_s = observer.speed_rms_err_rad_s();
   summary.speed_max_err_rad_s = observer.speed_max_err_rad_s();
+  summary.speed_rms_err_cmd_rad_s = observer.speed_rms_err_cmd_rad_s();
   summary.flux2_rms_err_Wb2 = metrics.flux2_rms_err_Wb2();
   summary.flux2_max_err_Wb2 = metrics.flux2_max_err_Wb2();
   summary.load_est_rms_err_Nm = metrics.load_est_rms_err_Nm();

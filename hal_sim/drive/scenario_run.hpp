@@ -44,6 +44,8 @@ struct LimitedSpan {
 /// when the run ended before settle_s.
 struct Summary {
   double speed_rms_err_rad_s = 0.0, speed_max_err_rad_s = 0.0;
+  /// Against the drive's ramped command for the same step, over running ticks (tick_observer.hpp).
+  double speed_rms_err_cmd_rad_s = 0.0;
   double flux2_rms_err_Wb2 = 0.0, flux2_max_err_Wb2 = 0.0;
   double load_est_rms_err_Nm = 0.0;
   double torque_rms_err_Nm = 0.0;  ///< iol: torque against the law's command one T0 earlier

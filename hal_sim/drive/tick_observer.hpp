@@ -58,6 +58,9 @@ struct ObservedRun {
   bool speed_reference = true;     ///< false: a torque-controlled run has no speed metric
   bool commands_over_can = false;  ///< the speed reference is the drive's, running ticks only
   double flux_decay = 0.0;         ///< e^{-eta T0} of the current-fed model (iol)
+  /// Ticks from the tick that records a speed command to the step it is for: the law aims at
+  /// the step after the input's, which acts pwm_latency_ticks later (1 or 2).
+  int command_lead_ticks = 2;
 };
 
 /// The observed run of a drive with this configuration.
@@ -71,7 +74,8 @@ inline ObservedRun observed_run(const ScenarioProfiles& references, double settl
           iol,
           !(iol && !drive.outer_speed_loop),
           drive.commands_over_can,
-          control::discretize_current_fed(motor, drive.iol_period_s).flux_decay};
+          control::discretize_current_fed(motor, drive.iol_period_s).flux_decay,
+          drive.pwm_latency_ticks + 1};
 }
 
 template <typename T>
@@ -91,6 +95,12 @@ class TickObserver {
   }
   double speed_max_err_rad_s() const noexcept {
     return run_.speed_reference ? metrics_.speed_max_err_rad_s() : std::nan("");
+  }
+  /// The speed against the drive's own command for the same step (after its acceleration
+  /// ramp), over the running ticks after settle_s: how well the drive follows what it was told,
+  /// without the ramp that a stepped reference with max_accel_rad_s2 adds to the error above.
+  double speed_rms_err_cmd_rad_s() const noexcept {
+    return run_.speed_reference ? rms(command_sq_, command_count_) : std::nan("");
   }
   /// iol: torque against the law's command one T0 earlier, and |i_AB - i_held| (NaN otherwise).
   double torque_rms_err_Nm() const noexcept { return rms(torque_sq_, torque_count_); }
@@ -130,6 +140,10 @@ class TickObserver {
   double pwm_ripple_sq_ = 0.0;
   uint64_t pwm_ripple_count_ = 0;
   double torque_sq_ = 0, hold_sq_ = 0;
+  double commands_[3] = {0.0, 0.0, 0.0};  ///< the last ticks' speed commands, by tick mod 3
+  uint64_t running_ticks_ = 0;            ///< consecutive running ticks up to this one
+  double command_sq_ = 0;
+  uint64_t command_count_ = 0;
   uint64_t torque_count_ = 0, hold_count_ = 0;
   Vec2 boundary_flux_s_ = Vec2::Zero();       ///< true stator flux (rotor frame), last boundary
   double pending_torque_cmd_ = std::nan("");  ///< the law's v1, due at the next boundary
@@ -219,6 +233,16 @@ const SimRow& TickObserver<T>::observe(double t_s, const PlantState& truth, doub
 
   const bool running = rec.state == firmware::DriveState::running;
   if (running_from_s_ < 0 && running) running_from_s_ = t_s;
+  // The command for this step was recorded command_lead_ticks ago, by a running tick.
+  running_ticks_ = running ? running_ticks_ + 1 : 0;
+  const int lead = run_.command_lead_ticks;
+  const uint64_t n = rows_seen_ - 1;  // this tick's row
+  if (t_s > run_.settle_s && lead >= 1 && lead <= 2 && running_ticks_ > uint64_t(lead)) {
+    const double err = row.omega_mech_rad_s - commands_[(n + 3 - uint64_t(lead)) % 3];
+    command_sq_ += err * err;
+    ++command_count_;
+  }
+  commands_[n % 3] = row.omega_ref_cmd_rad_s;
   // Over CAN the drive is stopped and started at the host's will: only running ticks count.
   metrics_.add({t_s, !run_.commands_over_can || running, row.omega_mech_rad_s - row.omega_ref_rad_s,
                 run_.current_fed_law ? row.stator_flux2_Wb2 - row.stator_flux2_ref_Wb2

@@ -83,6 +83,7 @@ nlohmann::ordered_json summary_json(const imd::sim::Scenario& s, const imd::sim:
       {"settle_s", s.settle_s},
       {"speed_rms_err_rad_s", r.speed_rms_err_rad_s},
       {"speed_max_err_rad_s", r.speed_max_err_rad_s},
+      {"speed_rms_err_cmd_rad_s", json_number(r.speed_rms_err_cmd_rad_s)},
       {"flux2_rms_err_Wb2", r.flux2_rms_err_Wb2},
       {"flux2_max_err_Wb2", r.flux2_max_err_Wb2},
       {"load_est_rms_err_Nm", r.load_est_rms_err_Nm},
