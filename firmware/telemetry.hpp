@@ -27,7 +27,7 @@ struct DriveStatus {
   FaultCode first_fault = FaultCode::none;
   uint64_t first_fault_tick = 0;
   uint8_t fault_detail = 0;
-  uint8_t controller = 0;  ///< 0 dsmc, 1 iol
+  uint8_t controller = 0;  ///< ControllerKind: 0 dsmc, 1 iol, 2 ifoc
   uint8_t command_counter = 0;
   uint32_t rejected_commands = 0;
   bool can_bus_off = false;

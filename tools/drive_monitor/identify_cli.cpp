@@ -63,6 +63,11 @@ int run_identify(const IdentifyOptions& o) {
     return ack.has_value();
   });
   if (!ack) return fail("identify: no acknowledgement", kExitNoAnswer);
+  if (ack->result == protocol::CommandResult::not_in_image) {
+    return fail("identify: rejected (not_in_image): this firmware image has no commissioning; "
+                "flash the commissioning image (docs/flashing.md)",
+                kExitRejected);
+  }
   if (ack->result != protocol::CommandResult::accepted) {
     return fail("identify: rejected (" + result_name(ack->result) +
                     "): the drive must be idle or unconfigured, with its enable line on",

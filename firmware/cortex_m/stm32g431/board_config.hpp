@@ -108,6 +108,10 @@ constexpr DriveConfig drive_config() {
   DriveConfig c;
   c.sample_period_s = Real(kControlPeriod_ns * 1e-9);
   c.controller = first_law_in_image();  // the run image's one law (docs/flashing.md)
+  // The IOL from its speed loop: the references come from CAN as speeds (set_speed), and
+  // without the loop the IOL would follow a torque reference nothing sets. The other laws
+  // do not read it.
+  c.outer_speed_loop = true;
   c.pwm_latency_ticks = 1;  // duties act from the next carrier peak (tim1_pwm.hpp)
   c.compensate_latency = true;
   c.speed_reaching_pole = Real(0.98);
