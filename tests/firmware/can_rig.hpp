@@ -41,6 +41,23 @@ struct CanRig {
     board.timer().start(drive);
   }
   void send(const protocol::Command& c) { board.can_side().inject(host.encode(c)); }
+  /// Enables the drive at `speed_rad_s` and runs until it runs (2 s at most), the speed sent
+  /// every 500 ticks to feed the command watchdog (0.1 s).
+  void enable_at(float speed_rad_s) {
+    send({protocol::CommandKind::set_speed, speed_rad_s});
+    send({protocol::CommandKind::enable});
+    for (int k = 0; k < 20000 && drive.state() != DriveState::running; ++k) {
+      run(1);
+      if (k % 500 == 0) send({protocol::CommandKind::set_speed, speed_rad_s});
+    }
+  }
+  /// Holds `speed_rad_s` for `ticks` (a multiple of 500), feeding the watchdog as above.
+  void hold(float speed_rad_s, int ticks) {
+    for (int n = 0; n < ticks / 500; ++n) {
+      send({protocol::CommandKind::set_speed, speed_rad_s});
+      run(500);
+    }
+  }
   void run(int ticks) {
     for (int k = 0; k < ticks; ++k) {
       board.run_tick();

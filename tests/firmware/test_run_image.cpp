@@ -53,17 +53,9 @@ TEST(RunImage, RefusesTheLawsAndTheCommissioningItDoesNotCarryAndChangesNothing)
 TEST(RunImage, RunsItsLaw) {
   CanRig rig;
   rig.run(300);
-  rig.send({CommandKind::set_speed, 30.0f});
-  rig.send({CommandKind::enable});
-  for (int k = 0; k < 20000 && rig.drive.state() != DriveState::running; ++k) {
-    rig.run(1);
-    if (k % 500 == 0) rig.send({CommandKind::set_speed, 30.0f});  // keep the watchdog fed
-  }
+  rig.enable_at(30.0f);
   ASSERT_EQ(rig.drive.state(), DriveState::running);
-  for (int n = 0; n < 20; ++n) {  // 1 s at 30 rad/s
-    rig.send({CommandKind::set_speed, 30.0f});
-    rig.run(500);
-  }
+  rig.hold(30.0f, 10000);  // 1 s
   // As in DriveCommands.EnableRuns...: the realistic board holds speed to 0.08 rad/s RMS
   // (docs/results.md); 0.5 rad/s is over six times that, far from a drive that did not run.
   EXPECT_NEAR(rig.board.plant().state().omega_mech_rad_s, 30.0, 0.5);
