@@ -388,17 +388,6 @@ void Drive<T>::write_line(int line, bool level) noexcept {
   if (hw_.gpio != nullptr && line >= 0) hw_.gpio->write(static_cast<uint8_t>(line), level);
 }
 
-template <typename T>
-void Drive<T>::shut_down(uint64_t k) noexcept {
-  pwm_off();
-  supervisor_.shut_down(k);
-  record_.state = supervisor_.state();
-  if (hw_.can != nullptr) {
-    telemetry_.final_heartbeat(*hw_.can, supervisor_.status(), supervisor_.machine());
-  }
-  write_line(config_.timing_output_line, false);
-}
-
 template class Drive<float>;
 template class Drive<double>;
 

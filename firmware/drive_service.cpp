@@ -1,6 +1,7 @@
 // The drive's service loop (Drive::service): what must not run in the tick. It rebuilds the
 // motor model after a parameter write or a commissioning, and on the tracked rotor resistance
-// (docs/robustness.md), and plans and adopts the commissioning. Main loop, never the tick.
+// (docs/robustness.md), and plans and adopts the commissioning; and the program's shut-down
+// after the last tick. Main loop, never the tick.
 #include <cmath>
 
 #include "firmware/drive.hpp"
@@ -117,9 +118,22 @@ std::optional<control::MotorParameters> Drive<T>::motor() const noexcept {
   return bank_.record();
 }
 
+template <typename T>
+void Drive<T>::shut_down(uint64_t k) noexcept {
+  pwm_off();
+  supervisor_.shut_down(k);
+  record_.state = supervisor_.state();
+  if (hw_.can != nullptr) {
+    telemetry_.final_heartbeat(*hw_.can, supervisor_.status(), supervisor_.machine());
+  }
+  write_line(config_.timing_output_line, false);
+}
+
 template void Drive<float>::service() noexcept;
 template void Drive<double>::service() noexcept;
 template std::optional<control::MotorParameters> Drive<float>::motor() const noexcept;
 template std::optional<control::MotorParameters> Drive<double>::motor() const noexcept;
+template void Drive<float>::shut_down(uint64_t) noexcept;
+template void Drive<double>::shut_down(uint64_t) noexcept;
 
 }  // namespace imd::firmware
