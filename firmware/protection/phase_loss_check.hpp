@@ -16,6 +16,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 
 #include "control/real.hpp"
 
@@ -33,13 +34,18 @@ class PhaseLossCheck {
     /// A phase that carries less than this share of its predicted current carries none: an
     /// open phase carries only the measurement noise, a healthy one all of it.
     Real carried_share = 0.5;
+    /// And the most an open phase's mean |i| over the window reads: the measurement noise
+    /// alone. A phase that carries more is connected: a model that mispredicts it (a rotor
+    /// resistance far from the record's, at speed) is not a lost phase. 0: no such bound.
+    Real open_mean_A = 0.0;
   };
 
   explicit PhaseLossCheck(const Config& c) noexcept
       : window_ticks_(std::max<uint32_t>(c.window_ticks, 1)),
         missing_A_per_bus_V_(T(c.missing_A_per_bus_V)),
         noise_floor_A_(T(c.noise_floor_A)),
-        carried_share_(T(c.carried_share)) {}
+        carried_share_(T(c.carried_share)),
+        open_mean_A_(c.open_mean_A > 0 ? T(c.open_mean_A) : std::numeric_limits<T>::infinity()) {}
 
   uint32_t window_ticks() const noexcept { return window_ticks_; }
   void reset() noexcept {
@@ -80,14 +86,15 @@ class PhaseLossCheck {
     }
     const T allowed_A = (missing_A_per_bus_V_ * v_bus_V + noise_floor_A_) * T(ticks_);
     const bool lost = predicted_A_[worst] - measured_A_[worst] > allowed_A &&
-                      measured_A_[worst] < carried_share_ * predicted_A_[worst];
+                      measured_A_[worst] < carried_share_ * predicted_A_[worst] &&
+                      measured_A_[worst] <= open_mean_A_ * T(ticks_);
     reset();
     return lost ? worst : -1;
   }
 
  private:
   uint32_t window_ticks_;
-  T missing_A_per_bus_V_, noise_floor_A_, carried_share_;
+  T missing_A_per_bus_V_, noise_floor_A_, carried_share_, open_mean_A_;
   T predicted_A_[3] = {T(0), T(0), T(0)};
   T measured_A_[3] = {T(0), T(0), T(0)};
   uint32_t ticks_ = 0;

@@ -58,6 +58,10 @@ typename PhaseLossCheck<T>::Config phase_loss_config(const control::MotorParamet
   c.missing_A_per_bus_V =
       config.protection.inverter_voltage_error_share / std::sqrt(Real(3.0)) * period_s / k.sigma_H;
   c.noise_floor_A = 6 * std::sqrt(Real(2.0)) * noise_A / std::sqrt(window);
+  // An open phase reads the noise alone: its mean |i| is 0.8 n (the mean of |N(0, n)|), and a
+  // window's mean lies within a few 0.6 n / sqrt(N) of that; 3 n leaves room for a residual
+  // offset of a code or two and for a board noisier than its setting.
+  c.open_mean_A = 3 * noise_A;
   return c;
 }
 

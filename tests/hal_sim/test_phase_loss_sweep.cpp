@@ -2,7 +2,8 @@
 // open phase injected at 30 times across the seed-000 realistic profile, each phase, with every
 // law, is found with the phase_loss code and the right phase; and no healthy run trips it, on
 // six motors with every law, at flux references and loads the shipped scenarios do not use,
-// and on the paper scenarios at flux references and sample periods they do not use.
+// with the rotor resistance at half and twice the record's, and on the paper scenarios at flux
+// references and sample periods they do not use.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -95,6 +96,31 @@ TEST(PhaseLossSweep, NoFalseTripOnAHealthyMotor) {
     }
   }
   std::printf("healthy sweep: %d runs, nothing tripped\n", runs);
+}
+
+TEST(PhaseLossSweep, NoFalseTripWithTheRotorResistanceFarFromTheRecord) {
+  // A cold rotor (0.5 x the record's Rr) and a hot one (2 x), on the six motors with every law,
+  // each board's own profile: until the tracker has converged the flux estimate is off, and at
+  // speed the one-step current prediction misses by several times what the check allows for
+  // the inverter (up to 4.9 times over a window, on the 7.5 kW motor). Its phases still carry
+  // their current, and none may be called lost: the 7.5 kW motor's DSMC with the cold rotor
+  // latched phase_loss at 1.9 s, accelerating to 80 rad/s, before the check required a lost
+  // phase to carry no more than an open one reads (its noise).
+  int runs = 0;
+  for (const char* file : test_boards::kRealistic) {
+    for (const char* law : kLaws) {
+      for (const double scale : {0.5, 2.0}) {
+        Scenario s = with_law(load_scenario(test::source_path(file)), law);
+        s.plant.Rr_Ohm = scale * s.motor.Rr_Ohm;
+        const Summary r = run_scenario(s);
+        ++runs;
+        EXPECT_LT(r.running_from_s, test_boards::running_by_s(s)) << file << " " << law << " x" << scale;
+        EXPECT_TRUE(r.faults.empty()) << file << " " << law << " Rr x" << scale << ": "
+                                      << faults_text(r);
+      }
+    }
+  }
+  std::printf("rotor resistance sweep: %d runs, nothing tripped\n", runs);
 }
 
 TEST(PhaseLossSweep, NoFalseTripOnThePaperScenarios) {
