@@ -29,7 +29,7 @@ class CheckingReporter final : public benchmark::ConsoleReporter {
         ++errors_;
         std::fprintf(stderr, "benchmark %s failed: %s\n", run.benchmark_name().c_str(),
                      run.error_message.c_str());
-      } else if (run.iterations > 0) {
+      } else if (run.iterations > 0 && is_time(run)) {
         seconds_[run.benchmark_name()] = run.GetAdjustedRealTime();
       }
     }
@@ -51,6 +51,13 @@ class CheckingReporter final : public benchmark::ConsoleReporter {
   }
 
  private:
+  /// A time to compare: a run, or the mean or median of repetitions (their standard deviation
+  /// and coefficient of variation are spreads, whose ratio says nothing of speed).
+  static bool is_time(const Run& run) {
+    return run.run_type != Run::RT_Aggregate || run.aggregate_name == "mean" ||
+           run.aggregate_name == "median";
+  }
+
   std::map<std::string, double> seconds_;
   int errors_ = 0;
 };
