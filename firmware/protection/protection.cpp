@@ -59,9 +59,10 @@ typename PhaseLossCheck<T>::Config phase_loss_config(const control::MotorParamet
       config.protection.inverter_voltage_error_share / std::sqrt(Real(3.0)) * period_s / k.sigma_H;
   c.noise_floor_A = 6 * std::sqrt(Real(2.0)) * noise_A / std::sqrt(window);
   // An open phase reads the noise alone: its mean |i| is 0.8 n (the mean of |N(0, n)|), and a
-  // window's mean lies within a few 0.6 n / sqrt(N) of that; 3 n leaves room for a residual
-  // offset of a code or two and for a board noisier than its setting.
-  c.open_mean_A = 3 * noise_A;
+  // window's mean lies within a few 0.6 n / sqrt(N) of that; 3 n leaves room for a board
+  // noisier than its setting, and two codes for the offset left after calibration or drifted
+  // since (a quiet converter's setting may be under a code).
+  c.open_mean_A = 3 * noise_A + 2 * adc_A_per_code;
   return c;
 }
 
