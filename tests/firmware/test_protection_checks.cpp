@@ -306,8 +306,10 @@ TEST(PhaseLossCheck, APhaseThatCarriesCurrentIsNotLostThoughTheModelMissesIt) {
   // over the window, phase a was predicted 400 A and carried 192 A (less than half), b and c
   // carried more than predicted. An open phase carries only its noise: this one is connected.
   PhaseLossCheck<double>::Config c = phase_loss_config();
-  c.missing_A_per_bus_V = 0.06 / 540.0;  // that board: 540 V, its windows allowed 42.6 A
-  c.noise_floor_A = 0.1;
+  // That board's window allowed 42.65 A of shortfall (1.706 A a tick on its 540 V bus): the
+  // split between the inverter's share and the noise's does not matter to the verdict.
+  c.missing_A_per_bus_V = 1.6 / 540.0;
+  c.noise_floor_A = 0.106;
   c.open_mean_A = 0.34;  // its 50 A ADC's four codes of noise, times 3, and two codes
   PhaseLossCheck<double> check(c);
   const double predicted[3] = {400.0 / 25, 481.6 / 25, -881.3 / 25};
