@@ -1,40 +1,37 @@
 # The qemu tier: drive_hil and drive_monitor on Debian's own kernels under QEMU, over vcan, and
 # on aarch64 with the virt machine's PL061 GPIO (tests/qemu/hil_test.py). The guests run a bare
-# busybox initramfs, so the host build also builds the two programs statically: natively for
-# the x86_64 guest and with the aarch64 cross toolchain for the aarch64 guest, each in its own
-# tree under the build directory, at -O2 as the host preset (CMake's Release is -O3: slower to
-# build, and no faster a loop for these tests). Debian's kernel packages are cached in
-# build/qemu-cache.
+# busybox initramfs. The x86_64 guest runs the host build's own programs, shipped with their
+# shared libraries (tests/qemu/guest_programs.py); the aarch64 guest runs them built statically
+# with the aarch64 cross toolchain, in their own tree under the build directory, at -O2 as the
+# host preset (CMake's Release is -O3: slower to build, and no faster a loop for these tests).
+# Debian's kernel packages are cached in build/qemu-cache.
 include(ExternalProject)
 set(IMD_QEMU_PROGRAMS drive_hil drive_monitor)
 set(IMD_QEMU_CACHE ${CMAKE_BINARY_DIR}/qemu-cache)
 
-function(imd_qemu_programs ARCH)
-  ExternalProject_Add(qemu_programs_${ARCH}
+find_program(IMD_AARCH64_CXX aarch64-linux-gnu-g++)
+if(IMD_AARCH64_CXX)
+  ExternalProject_Add(qemu_programs_aarch64
     SOURCE_DIR ${PROJECT_SOURCE_DIR}
-    BINARY_DIR ${CMAKE_BINARY_DIR}/qemu-${ARCH}
+    BINARY_DIR ${CMAKE_BINARY_DIR}/qemu-aarch64
     CMAKE_ARGS -DCMAKE_BUILD_TYPE=Release "-DCMAKE_CXX_FLAGS_RELEASE=-O2 -DNDEBUG"
-               -DIMD_BUILD_TESTS=OFF -DIMD_BUILD_BENCHMARKS=OFF -DIMD_STATIC_LINK=ON ${ARGN}
+               -DIMD_BUILD_TESTS=OFF -DIMD_BUILD_BENCHMARKS=OFF -DIMD_STATIC_LINK=ON
+               -DCMAKE_TOOLCHAIN_FILE=${PROJECT_SOURCE_DIR}/toolchains/aarch64-linux-gnu.cmake
     BUILD_COMMAND ${CMAKE_COMMAND} --build <BINARY_DIR> --target ${IMD_QEMU_PROGRAMS}
     INSTALL_COMMAND ""
     BUILD_ALWAYS ON)  # the sources are this project's: let its own build decide what changed
-endfunction()
-
-imd_qemu_programs(x86_64)
-find_program(IMD_AARCH64_CXX aarch64-linux-gnu-g++)
-if(IMD_AARCH64_CXX)
-  imd_qemu_programs(aarch64
-    -DCMAKE_TOOLCHAIN_FILE=${PROJECT_SOURCE_DIR}/toolchains/aarch64-linux-gnu.cmake)
 else()
   # The test below then fails and says how to get the cross toolchain.
   message(WARNING "aarch64-linux-gnu-g++ not found: the qemu_hil_aarch64 test will fail "
                   "(tools/install_deps.sh --aarch64 installs it)")
 endif()
 
+set(IMD_QEMU_BIN_x86_64 $<TARGET_FILE_DIR:drive_hil>)
+set(IMD_QEMU_BIN_aarch64 ${CMAKE_BINARY_DIR}/qemu-aarch64/bin)
 foreach(arch x86_64 aarch64)
   add_test(NAME qemu_hil_${arch}
            COMMAND /usr/bin/python3 ${CMAKE_CURRENT_SOURCE_DIR}/qemu/hil_test.py
-                   --arch ${arch} --bin-dir ${CMAKE_BINARY_DIR}/qemu-${arch}/bin
+                   --arch ${arch} --bin-dir ${IMD_QEMU_BIN_${arch}}
                    --source-dir ${PROJECT_SOURCE_DIR} --cache ${IMD_QEMU_CACHE}
                    --work ${CMAKE_BINARY_DIR}/qemu-work-${arch})
   # Alone on the machine: each QEMU keeps one core busy, and the guest's loop is timed. The
@@ -46,7 +43,7 @@ endforeach()
 # the host's interpreter and python3-can shipped into it (tests/qemu/python_test.py).
 add_test(NAME qemu_python_client
          COMMAND /usr/bin/python3 -B ${CMAKE_CURRENT_SOURCE_DIR}/qemu/python_test.py
-                 --bin-dir ${CMAKE_BINARY_DIR}/qemu-x86_64/bin --source-dir ${PROJECT_SOURCE_DIR}
+                 --bin-dir $<TARGET_FILE_DIR:drive_hil> --source-dir ${PROJECT_SOURCE_DIR}
                  --cache ${IMD_QEMU_CACHE} --work ${CMAKE_BINARY_DIR}/qemu-work-python)
 set_tests_properties(qemu_python_client PROPERTIES LABELS qemu RUN_SERIAL ON TIMEOUT 300)
 

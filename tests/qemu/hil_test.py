@@ -1,6 +1,7 @@
 #!/usr/bin/python3
 """The qemu tier's host-in-the-loop test: boots a Debian kernel under QEMU (qemu_guest.py) with
-the statically linked drive_hil and drive_monitor, runs guest_hil.sh in it, and checks what the
+drive_hil and drive_monitor (on x86_64 the host build's own, with their shared libraries; on
+aarch64 the static cross build: guest_programs.py), runs guest_hil.sh in it, and checks what the
 guest emitted.
 
 usage: hil_test.py --arch x86_64|aarch64 --bin-dir DIR --source-dir DIR --cache DIR --work DIR
@@ -24,6 +25,7 @@ from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
+import guest_programs  # noqa: E402
 import qemu_guest  # noqa: E402  (the PL061 trace reader)
 
 FAULT_PIN, TIMING_PIN = 5, 6
@@ -202,7 +204,8 @@ def main():
     missing = [str(p) for p in programs if not p.is_file()]
     if missing:
         print(f"hil_test: missing {', '.join(missing)}: the host build makes them "
-              f"(build/qemu-{args.arch}; for aarch64 it needs tools/install_deps.sh --aarch64)")
+              f"(build/bin; for aarch64 build/qemu-aarch64, which needs tools/install_deps.sh "
+              f"--aarch64)")
         return 2
     gpio = args.arch == "aarch64"
     args.work.mkdir(parents=True, exist_ok=True)
@@ -220,8 +223,11 @@ def main():
                # 45 s on an idle host; a busy 2-core host slows the emulated guest several
                # times over. Below ctest's 400 s for the test (tests/qemu.cmake).
                "--timeout-s", "330", "--cpus", "2"]
-    for program in programs:
+    binaries, libraries = guest_programs.stage(programs, args.work / "programs")
+    for program in binaries:
         command += ["--binary", str(program)]
+    for spec in libraries:
+        command += ["--file", spec]
     if gpio:
         command += ["--trace-pl061", str(trace)]
     guest = subprocess.run(command)

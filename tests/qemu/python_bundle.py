@@ -3,11 +3,11 @@ it and for the extension modules shipped, the standard library without what a te
 imports (tests, IDLE, tkinter, ensurepip, lib2to3, pydoc_data, bytecode caches), and python3-can
 with the Debian packages it depends on. Staged as a directory tree that mirrors the guest's
 root, to be shipped with qemu_guest.py --file DIR:/ (one --file per top-level directory)."""
-import re
 import shutil
-import subprocess
 import sys
 from pathlib import Path
+
+from guest_programs import ldd_paths
 
 STDLIB_SKIP = {"test", "idlelib", "tkinter", "ensurepip", "lib2to3", "pydoc_data", "turtledemo",
                "__pycache__", "site-packages", "dist-packages", "unittest", "distutils"}
@@ -16,17 +16,6 @@ STDLIB_SKIP = {"test", "idlelib", "tkinter", "ensurepip", "lib2to3", "pydoc_data
 DIST_PACKAGES = ["can", "pkg_resources", "serial", "msgpack", "packaging", "wrapt",
                  "typing_extensions.py"]
 DIST_DIR = Path("/usr/lib/python3/dist-packages")
-
-
-def ldd_paths(binary):
-    """The files the dynamic loader maps for `binary` (resolved), by their ldd paths."""
-    out = subprocess.run(["ldd", str(binary)], capture_output=True, text=True).stdout
-    paths = []
-    for line in out.splitlines():
-        match = re.search(r"(/\S+) \(0x", line)
-        if match:
-            paths.append(match.group(1))
-    return paths
 
 
 def copy_tree(source, target, skip=()):

@@ -1,6 +1,6 @@
 #!/usr/bin/python3
 """The qemu tier's Python client test: boots Debian's x86_64 kernel (qemu_guest.py) with the
-static drive_hil, the host's Python interpreter and python3-can (python_bundle.py) and the
+host build's drive_hil and its shared libraries (guest_programs.py), the host's Python interpreter and python3-can (python_bundle.py) and the
 imdrive package, and checks that the client, over vcan0, finds the drive idle, reads a
 parameter, enables it, sets a speed and sees it held in telemetry, sees the command
 watchdog trip by name when it stops commanding, and an emergency stop latched by name.
@@ -15,6 +15,7 @@ from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
+import guest_programs  # noqa: E402
 import python_bundle  # noqa: E402
 
 CHECKS = ["idle", "parameter_read", "speed", "watchdog_fault", "emergency_stop",
@@ -28,15 +29,18 @@ def main():
     args = parser.parse_args()
     hil = args.bin_dir / "drive_hil"
     if not hil.is_file():
-        print(f"python_test: missing {hil}: the host build makes it (build/qemu-x86_64)")
+        print(f"python_test: missing {hil}: the host build makes it (build/bin)")
         return 2
     started = time.monotonic()
     args.work.mkdir(parents=True, exist_ok=True)
-    tops = python_bundle.stage(args.work / "python-root", args.source_dir / "tools/python")
+    root = args.work / "python-root"
+    tops = python_bundle.stage(root, args.source_dir / "tools/python")
+    in_bundle = {f"/{p.relative_to(root)}" for p in root.rglob("*") if p.is_file()}
+    binaries, libraries = guest_programs.stage([hil], args.work / "programs", in_bundle)
     src = args.source_dir
     command = [sys.executable, str(HERE / "qemu_guest.py"), "--arch", "x86_64",
                "--cache", str(args.cache), "--work", str(args.work),
-               "--guest-script", str(HERE / "guest_python.sh"), "--binary", str(hil),
+               "--guest-script", str(HERE / "guest_python.sh"), "--binary", str(binaries[0]),
                "--file", f"{HERE / 'python_guest.py'}:/hil/python_guest.py",
                "--file", f"{src / 'tests/qemu/hil.toml'}:/hil/tests/qemu/hil.toml",
                "--file", f"{src / 'hal_sim/motors/seed000.toml'}:/hil/hal_sim/motors/seed000.toml",
@@ -44,6 +48,8 @@ def main():
                "--timeout-s", "240", "--cpus", "2", "--memory-mb", "1024"]
     for top in tops:
         command += ["--file", f"{top}:/{top.name}"]
+    for spec in libraries:
+        command += ["--file", spec]
     guest = subprocess.run(command)
     out = args.work / "out"
     log = (out / "python.log").read_text() if (out / "python.log").is_file() else ""

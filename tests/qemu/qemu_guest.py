@@ -206,7 +206,7 @@ def prepare(args):
             raise SetupError(f"--binary {binary}: no such file")
         if f"/bin/{binary.name}" in HARNESS_PATHS:
             raise SetupError(f"--binary {binary}: /bin/{binary.name} belongs to qemu_guest.py")
-        check_guest_program(binary, arch, {guest_path for _, guest_path in files})
+        check_guest_program(binary, arch, shipped_paths(files))
 
     args.cache.mkdir(parents=True, exist_ok=True)
     check_dpkg_architecture(ARCHES[arch]["debian"])
@@ -281,6 +281,17 @@ def report(args, console, qemu_code, timed_out, total_s, stderr_path):
               file=sys.stderr)
     print("qemu_guest: PASSED")
     return 0
+
+
+def shipped_paths(files):
+    """The guest paths of the files shipped, those inside a shipped directory included."""
+    paths = set()
+    for source, guest_path in files:
+        paths.add(guest_path)
+        if source.is_dir():
+            root = guest_path.rstrip("/")
+            paths.update(f"{root}/{p.relative_to(source)}" for p in source.rglob("*"))
+    return paths
 
 
 def main():
