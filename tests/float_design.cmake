@@ -27,7 +27,7 @@ foreach(name test_voltage_fed_scenarios test_current_fed_scenarios test_rotor_re
              test_dsmc_torque_channel test_fault_matrix test_field_weakening test_phase_loss_sweep
              test_iol_voltage_limit_sweep test_stop_categories test_fault_recovery
              test_encoder_check_sweep test_adc_stuck_sweep test_commissioning_scenarios
-             test_magnetizing_sweep test_lockstep_agreement
+             test_magnetizing_sweep test_lockstep_agreement test_random_healthy_sweep
              test_drive_at_20kHz)
   imd_add_test(${name} sim LIBRARIES imd_sim_drive SOURCES hal_sim/${name}.cpp)
 endforeach()
@@ -42,5 +42,5 @@ set(IMD_FLOAT_DESIGN_TESTS
     test_rotor_resistance_tracking test_dsmc_torque_channel test_fault_matrix
     test_field_weakening test_phase_loss_sweep test_iol_voltage_limit_sweep test_stop_categories
     test_fault_recovery test_encoder_check_sweep test_adc_stuck_sweep test_commissioning_scenarios
-    test_magnetizing_sweep test_lockstep_agreement test_drive_at_20kHz)
+    test_magnetizing_sweep test_lockstep_agreement test_drive_at_20kHz test_random_healthy_sweep)
 add_custom_target(float_design_tests DEPENDS ${IMD_FLOAT_DESIGN_TESTS})

@@ -10,8 +10,9 @@
 ///   J dw_lo/dt = T - L_max - c w_lo,   J dw_hi/dt = T + L_max - c w_hi,
 /// with T the electromagnetic torque the drive applies, c the friction and L_max the largest
 /// load the check allows for (either sign). They start from the speed estimate at the count,
-/// widened by its quantization error and by the lag a load step of L_max leaves in the encoder
-/// observer (L_max / (J w_obs)). The travel since the count lies between their integrals. A
+/// widened by its quantization error and by the lag the largest load step leaves in the encoder
+/// observer: a load anywhere within +-L_max can step by 2 L_max, from one end to the other
+/// (2 L_max / (J w_obs)). The travel since the count lies between their integrals. A
 /// healthy encoder counts once the rotor has crossed `missing_counts` count edges (one for the
 /// unknown place within the count at the start, one to spare): if the lower travel bound
 /// exceeds that, or the upper one falls below minus that, with no count seen, the encoder has
@@ -81,7 +82,7 @@ class EncoderCheck {
       return false;
     }
     if (delta_counts != 0 || !anchored_) {  // a count: the rotor is at a count edge now
-      const T margin = speed_error_rad_s_ + max_load_Nm * lag_per_Nm_;
+      const T margin = speed_error_rad_s_ + T(2) * max_load_Nm * lag_per_Nm_;
       omega_lo_ = omega_est_rad_s - margin;
       omega_hi_ = omega_est_rad_s + margin;
       travel_lo_ = travel_hi_ = T(0);

@@ -130,7 +130,9 @@ TEST(FaultMatrix, EncoderLossAtLowSpeed) {
   const double l_max = 0.75 * t_cap;
   const auto e = control::encoder_quantization_bounds(
       control::discretize_voltage_fed(m, s.sample_period_s), s.encoder_bandwidth_rad_s, q);
-  double omega = -(e.omega_rad_s + l_max / (m.J_kgm2 * s.encoder_bandwidth_rad_s)), x = 0.0;
+  // The check's margin at the last count: the quantization error and the observer's lag
+  // after a load step of 2 L_max (from one end of the bound to the other).
+  double omega = -(e.omega_rad_s + 2 * l_max / (m.J_kgm2 * s.encoder_bandwidth_rad_s)), x = 0.0;
   double t = 0.0;
   const double t_full = 4.0 / 100.0;  // the speed loop's 100 rad/s (control/ifoc_design.hpp)
   for (; x <= 2 * q && t < 1.0; t += kTick_s) {
