@@ -1,7 +1,7 @@
 // Healthy motors on cases that no scenario file and no other sweep writes: each case draws a
 // motor of the six, a law, a rotor-flux reference, a plant that differs from the record
-// (within the robustness maps' ranges), a speed profile of steps with reversals, and a load of steps of
-// either sign (overhauling loads among them), from a fixed seed. Nothing may trip: the
+// (within the robustness maps' ranges), a speed profile of steps with reversals, and a load of
+// steps of either sign (overhauling loads among them), from a fixed seed. Nothing may trip: the
 // protections' thresholds follow from the motor, the board and the period, so a case they
 // were not written for is no reason to trip. Each case's draw is printed when it fails, so it
 // can be run again on its own (IMD_RANDOM_CASES=first:count).
@@ -37,10 +37,11 @@ struct Case {
 
 /// The draw: the plant within one of docs/robustness.md's two maps (the resistances, or the
 /// magnetizing inductance and the inertia), the rotor resistance from a cold rotor to a hot one
-/// (0.5 to 2); speeds within 0.8 of base speed (the voltage the
-/// drive keeps in reserve); loads within half the torque at the current limit, so that the
-/// speed loops keep authority over the worst plant (J three times the record's accelerates a
-/// third as fast, and no law may be asked for more than it has).
+/// (0.5 to 2); speeds within 0.8 of base speed (the voltage the drive keeps in reserve); loads
+/// within half the torque at the current limit, so that the speed loops keep authority over
+/// the worst plant (J three times the record's accelerates a third as fast, and no law may be
+/// asked for more than it has). libstdc++'s distributions make the draws the same everywhere
+/// this project builds.
 Case draw(std::mt19937_64& rng) {
   auto uniform = [&](double lo, double hi) {
     return std::uniform_real_distribution<double>(lo, hi)(rng);

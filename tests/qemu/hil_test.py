@@ -223,7 +223,11 @@ def main():
                # 45 s on an idle host; a busy 2-core host slows the emulated guest several
                # times over. Below ctest's 400 s for the test (tests/qemu.cmake).
                "--timeout-s", "330", "--cpus", "2"]
-    binaries, libraries = guest_programs.stage(programs, args.work / "programs")
+    try:
+        binaries, libraries = guest_programs.stage(programs, args.work / "programs")
+    except guest_programs.ShipError as error:
+        print(f"hil_test: {error}")
+        return 2
     for program in binaries:
         command += ["--binary", str(program)]
     for spec in libraries:

@@ -1,9 +1,10 @@
 #!/usr/bin/python3
 """The qemu tier's Python client test: boots Debian's x86_64 kernel (qemu_guest.py) with the
-host build's drive_hil and its shared libraries (guest_programs.py), the host's Python interpreter and python3-can (python_bundle.py) and the
-imdrive package, and checks that the client, over vcan0, finds the drive idle, reads a
-parameter, enables it, sets a speed and sees it held in telemetry, sees the command
-watchdog trip by name when it stops commanding, and an emergency stop latched by name.
+host build's drive_hil and its shared libraries (guest_programs.py), the host's Python
+interpreter and python3-can (python_bundle.py) and the imdrive package, and checks that the
+client, over vcan0, finds the drive idle, reads a parameter, enables it, sets a speed and sees
+it held in telemetry, sees the command watchdog trip by name when it stops commanding, and an
+emergency stop latched by name.
 
 usage: python_test.py --bin-dir DIR --source-dir DIR --cache DIR --work DIR
 """
@@ -36,7 +37,11 @@ def main():
     root = args.work / "python-root"
     tops = python_bundle.stage(root, args.source_dir / "tools/python")
     in_bundle = {f"/{p.relative_to(root)}" for p in root.rglob("*") if p.is_file()}
-    binaries, libraries = guest_programs.stage([hil], args.work / "programs", in_bundle)
+    try:
+        binaries, libraries = guest_programs.stage([hil], args.work / "programs", in_bundle)
+    except guest_programs.ShipError as error:
+        print(f"python_test: {error}")
+        return 2
     src = args.source_dir
     command = [sys.executable, str(HERE / "qemu_guest.py"), "--arch", "x86_64",
                "--cache", str(args.cache), "--work", str(args.work),
