@@ -86,8 +86,8 @@ Scenario scenario_of(const Case& c) {
   s.plant.Ls_H = m.Ls_H + s.plant.Lm_H - m.Lm_H;  // the leakages stay (saturation)
   s.plant.Lr_H = m.Lr_H + s.plant.Lm_H - m.Lm_H;
   s.plant.J_kgm2 = c.J * m.J_kgm2;
-  // Within base speed and within the overspeed trip (the 0.55 kW motor's base speed at 0.6 of
-  // its flux is 570 rad/s, beyond the default 400), each with the 0.8 of the draw's range.
+  // The draw's shares (at most 0.8) of the lower of base speed and the overspeed trip (the
+  // 0.55 kW motor's base speed at 0.6 of its flux is 570 rad/s, beyond the default 400).
   const double overspeed_rad_s =
       s.protection.overspeed_rad_s.value_or(double(firmware::ProtectionConfig{}.overspeed_rad_s));
   const double w = std::min(base_speed_rad_s(s, s.flux2_Wb2), overspeed_rad_s);
@@ -112,7 +112,8 @@ Scenario scenario_of(const Case& c) {
 TEST(RandomHealthySweep, NothingTripsOnCasesNoScenarioWrites) {
   int first = 0, count = 200;
   if (const char* range = std::getenv("IMD_RANDOM_CASES")) {
-    std::sscanf(range, "%d:%d", &first, &count);
+    ASSERT_TRUE(std::sscanf(range, "%d:%d", &first, &count) == 2 && first >= 0 && count > 0)
+        << "IMD_RANDOM_CASES=" << range << ": expected first:count, e.g. 200:1000";
   }
   std::mt19937_64 rng(20261128);
   int runs = 0;
