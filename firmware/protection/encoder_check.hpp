@@ -59,7 +59,8 @@ class EncoderCheck {
         friction_(T(c.friction_Nms)),
         missing_rad_(T(c.missing_counts * 2 * std::numbers::pi_v<Real> / c.counts_per_rev)),
         speed_error_rad_s_(T(c.speed_error_rad_s)),
-        lag_per_Nm_(T(1 / (c.J_kgm2 * c.observer_bandwidth_rad_s))),
+        // The lag after a load step of 2 L_max, per newton metre of L_max (doubling is exact).
+        step_lag_per_Nm_(T(2 / (c.J_kgm2 * c.observer_bandwidth_rad_s))),
         max_jump_counts_(max_jump(c.overspeed_rad_s, c.period_s, c.counts_per_rev)) {
     reset();
   }
@@ -82,7 +83,7 @@ class EncoderCheck {
       return false;
     }
     if (delta_counts != 0 || !anchored_) {  // a count: the rotor is at a count edge now
-      const T margin = speed_error_rad_s_ + T(2) * max_load_Nm * lag_per_Nm_;
+      const T margin = speed_error_rad_s_ + max_load_Nm * step_lag_per_Nm_;
       omega_lo_ = omega_est_rad_s - margin;
       omega_hi_ = omega_est_rad_s + margin;
       travel_lo_ = travel_hi_ = T(0);
@@ -113,7 +114,7 @@ class EncoderCheck {
   }
 
  private:
-  T period_s_, period_per_J_, friction_, missing_rad_, speed_error_rad_s_, lag_per_Nm_;
+  T period_s_, period_per_J_, friction_, missing_rad_, speed_error_rad_s_, step_lag_per_Nm_;
   int32_t max_jump_counts_;
   bool anchored_ = false;
   T omega_lo_ = T(0), omega_hi_ = T(0), travel_lo_ = T(0), travel_hi_ = T(0);

@@ -15,6 +15,20 @@ inline constexpr const char* kRealistic[] = {"hal_sim/scenarios/seed000_realisti
                                              "tests/data/scenarios/two_pole_550W_realistic.toml",
                                              "tests/data/scenarios/eight_pole_15kW_realistic.toml"};
 
+/// `s` with its plant off the motor record by the ratios (plant over record) of the rotor and
+/// stator resistances, the magnetizing inductance (the leakages kept, as when the iron
+/// saturates) and the inertia.
+inline Scenario with_plant_error(Scenario s, double Rr, double Rs, double Lm, double J) {
+  const control::MotorParameters& m = s.motor;
+  s.plant.Rr_Ohm = Rr * m.Rr_Ohm;
+  s.plant.Rs_Ohm = Rs * m.Rs_Ohm;
+  s.plant.Lm_H = Lm * m.Lm_H;
+  s.plant.Ls_H = m.Ls_H + s.plant.Lm_H - m.Lm_H;
+  s.plant.Lr_H = m.Lr_H + s.plant.Lm_H - m.Lm_H;
+  s.plant.J_kgm2 = J * m.J_kgm2;
+  return s;
+}
+
 /// When the drive runs, from enable at 0: the offset calibration (256 ticks), then the model's
 /// magnetizing time (firmware/protection/magnetizing_timeout.hpp) and a fifth more for the
 /// current's rise and the flux estimate's lag. 0.21 s for the paper-000 motor, 1.6 s for the

@@ -127,14 +127,9 @@ TEST_P(PlantErrorSweep, NothingTrips) {
   int runs = 0;
   for (const char* law : kLaws) {
     for (const PlantError& error : kPlantErrors) {
-      Scenario s = with_law(load_scenario(test::source_path(file)), law);
-      const control::MotorParameters& m = s.motor;
-      s.plant.Rr_Ohm = error.Rr * m.Rr_Ohm;
-      s.plant.Rs_Ohm = error.Rs * m.Rs_Ohm;
-      s.plant.Lm_H = error.Lm * m.Lm_H;
-      s.plant.Ls_H = m.Ls_H + s.plant.Lm_H - m.Lm_H;
-      s.plant.Lr_H = m.Lr_H + s.plant.Lm_H - m.Lm_H;
-      s.plant.J_kgm2 = error.J * m.J_kgm2;
+      const Scenario s =
+          test_boards::with_plant_error(with_law(load_scenario(test::source_path(file)), law),
+                                        error.Rr, error.Rs, error.Lm, error.J);
       const Summary r = run_scenario(s);
       ++runs;
       EXPECT_LT(r.running_from_s, test_boards::running_by_s(s)) << law << " " << error.name;

@@ -76,16 +76,11 @@ std::string text(const Case& c) {
 }
 
 Scenario scenario_of(const Case& c) {
-  Scenario s = with_law(load_scenario(test::source_path(c.file),
-                                      {"simulation.seed=" + std::to_string(c.seed)}),
-                        c.law, c.flux_share);
-  const control::MotorParameters& m = s.motor;
-  s.plant.Rr_Ohm = c.Rr * m.Rr_Ohm;
-  s.plant.Rs_Ohm = c.Rs * m.Rs_Ohm;
-  s.plant.Lm_H = c.Lm * m.Lm_H;
-  s.plant.Ls_H = m.Ls_H + s.plant.Lm_H - m.Lm_H;  // the leakages stay (saturation)
-  s.plant.Lr_H = m.Lr_H + s.plant.Lm_H - m.Lm_H;
-  s.plant.J_kgm2 = c.J * m.J_kgm2;
+  Scenario s = test_boards::with_plant_error(
+      with_law(load_scenario(test::source_path(c.file),
+                             {"simulation.seed=" + std::to_string(c.seed)}),
+               c.law, c.flux_share),
+      c.Rr, c.Rs, c.Lm, c.J);
   // The draw's shares (at most 0.8) of the lower of base speed and the overspeed trip (the
   // 0.55 kW motor's base speed at 0.6 of its flux is 570 rad/s, beyond the default 400).
   const double overspeed_rad_s =
