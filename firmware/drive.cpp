@@ -80,6 +80,11 @@ void Drive<T>::on_tick() noexcept {
   clock.lap(Stage::law);
   const Modulation<T> out = modulate(plan, u, e, m, model);
   clock.lap(Stage::modulate);
+  const bool law_voltage = actuate(out, model);
+  const Trip overrun = check_budget(clock.lap_total(Stage::actuate));
+  if (hw_.watchdog != nullptr) hw_.watchdog->feed();  // the PWM is written: the tick lives
+  // Every trip decision follows the write: hal::Pwm latches the duties for the next period, so
+  // a trip that turns the PWM off in this tick keeps them from ever acting, as before the write.
   SupervisedState supervised = plan.supervised;
   supervised.brake_may_hold =
       config_.brake_output_line >= 0 &&
@@ -88,10 +93,8 @@ void Drive<T>::on_tick() noexcept {
   Trip trip = protection_.check(m, e, supervised, u, out, e.valid ? &model->checks : nullptr);
   // The power stage's own over-current trip already turned the outputs off: latch it.
   if (hw_.pwm.tripped()) trip.add(FaultCode::overcurrent, kHardwareTripDetail);
+  react(k, e, out, trip, overrun, law_voltage, model);
   clock.lap(Stage::protect);
-  actuate(k, e, out, trip, model);
-  check_budget(k, clock.lap_total(Stage::actuate), model);
-  if (hw_.watchdog != nullptr) hw_.watchdog->feed();  // the PWM is written: the tick lives
   after_write(m, e, u_acted_V, model);
   publish(k, m, e, plan, u, out, model);
   end_identification(k);
@@ -252,61 +255,65 @@ inline Modulation<T> Drive<T>::modulate(const TickPlan<T>& plan, const LawOutput
 }
 
 template <typename T>
-inline void Drive<T>::actuate(uint64_t k, const Estimate<T>& e, const Modulation<T>& out,
-                              const Trip& trip, MotorModel<T>* model) noexcept {
-  v_applied_V_ = Vec2::Zero();
-  Vec2 u_applied_V = Vec2::Zero();
-  // A fault takes its stop: STO turns the PWM off now; a controlled stop (SS1, DC braking)
-  // starts from the next tick, this tick's output still written.
-  StopContext<T> motion;
-  if (trip.any() && model != nullptr && e.valid && substitutes_.power_stage == nullptr &&
-      !supervisor_.fault_stopping()) {
-    motion.omega_mech_rad_s = e.x.omega_mech_rad_s;
-    motion.dc_brake_ticks = model->dc_brake.begin(e.x.omega_mech_rad_s);
-  }
-  if (trip.any() && supervisor_.latch(trip, k, motion)) {
-    pwm_off();
-  } else if (supervisor_.state() == DriveState::identifying ||
-             (out.direct && supervisor_.modulating() && model != nullptr)) {
+inline bool Drive<T>::actuate(const Modulation<T>& out, MotorModel<T>* model) noexcept {
+  if (supervisor_.state() == DriveState::identifying ||
+      (out.direct && supervisor_.modulating() && model != nullptr)) {
     hw_.pwm.set_duties(out.duty);  // the commissioning's or DC braking's own voltage
     hw_.pwm.enable();
-    if (supervisor_.state() != DriveState::identifying) {
-      v_applied_V_ = out.v_acting_AB_V;
-      u_applied_V = out.u_acting_alphabeta_V;
-    }
-  } else if (supervisor_.modulating() && model != nullptr) {
+    return supervisor_.state() != DriveState::identifying;
+  }
+  if (supervisor_.modulating() && model != nullptr) {
     if (substitutes_.power_stage != nullptr) {
       substitutes_.power_stage->write(out);
     } else {
       model->svpwm.write(out);
     }
-    v_applied_V_ = out.v_acting_AB_V;
-    u_applied_V = out.u_acting_alphabeta_V;
-  } else if (hw_.pwm.enabled()) {
+    return true;
+  }
+  if (hw_.pwm.enabled()) pwm_off();
+  return false;
+}
+
+template <typename T>
+inline void Drive<T>::react(uint64_t k, const Estimate<T>& e, const Modulation<T>& out,
+                            const Trip& trip, const Trip& overrun, bool law_voltage,
+                            MotorModel<T>* model) noexcept {
+  // A fault takes its stop: STO turns the PWM off now, before the written duties act; a
+  // controlled stop (SS1, DC braking) starts from the next tick, this tick's output acting.
+  if (trip.any()) {
+    StopContext<T> motion;
+    if (model != nullptr && e.valid && substitutes_.power_stage == nullptr &&
+        !supervisor_.fault_stopping()) {
+      motion.omega_mech_rad_s = e.x.omega_mech_rad_s;
+      motion.dc_brake_ticks = model->dc_brake.begin(e.x.omega_mech_rad_s);
+    }
+    if (supervisor_.latch(trip, k, motion)) pwm_off();
+  }
+  if (overrun.any()) {
+    supervisor_.latch(overrun, k);  // STO: the late duties never act
     pwm_off();
   }
-  if (!hw_.pwm.enabled()) v_applied_V_ = u_applied_V = Vec2::Zero();
+  const bool acting = law_voltage && hw_.pwm.enabled();
+  v_applied_V_ = acting ? out.v_acting_AB_V : Vec2::Zero();
   // The input acting over [k, k+1], for the observers: they advance after the PWM write.
   if (e.valid && model != nullptr) {
     v_acting_V_ = model->predictor.written(v_applied_V_);
     observers_due_ = true;
-    u_last_period_V_ = model->predictor.written_stator(u_applied_V);
+    u_last_period_V_ =
+        model->predictor.written_stator(acting ? out.u_acting_alphabeta_V : Vec2::Zero());
   } else {
     u_last_period_V_ = Vec2::Zero();
   }
 }
 
 template <typename T>
-inline void Drive<T>::check_budget(uint64_t k, uint32_t counts, MotorModel<T>* model) noexcept {
+inline Trip Drive<T>::check_budget(uint32_t counts) noexcept {
   const float exec_ns = float(counts) * ns_per_count_;  // within float's 2^-24
   record_.exec_ns = exec_ns < 4e9f ? static_cast<uint32_t>(exec_ns) : UINT32_MAX;
   execution_.add(record_.exec_ns);
   const Trip overrun = protection_.over_budget(counts);
-  if (!overrun.any()) return;
-  ++execution_.overruns;
-  supervisor_.latch(overrun, k);  // STO
-  pwm_off();                      // the PWM is off before the next period starts
-  if (model != nullptr) model->predictor.cancel_in_flight();  // this tick's voltage never acts
+  if (overrun.any()) ++execution_.overruns;
+  return overrun;
 }
 
 template <typename T>

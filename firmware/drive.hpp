@@ -1,14 +1,15 @@
 #pragma once
 /// The drive: one control tick per period of the control timer, as a sequence of stages that
 /// hand values to each other (docs/architecture.md has the picture):
-///   sense -> estimate -> supervise -> law -> modulate -> protect -> actuate -> publish
+///   sense -> estimate -> supervise -> law -> modulate -> actuate -> protect -> publish
 /// sense: ADC and encoder -> Measurement; estimate: observers and the prediction over the PWM
 /// latency -> Estimate; supervise: commands and state transitions -> TickPlan; law: the
 /// magnetizing current or the selected control law -> LawOutput; modulate: inner feedback (2),
-/// limits, SVPWM -> Modulation; protect: every trip decision -> Trip; actuate: the PWM write,
-/// or the PWM off in the same tick as a trip; publish: the tick record and CAN telemetry. What
-/// the PWM write does not wait for runs after it, timed with publish: the observers advanced over
-/// the next period and the rotor-resistance tracker's step.
+/// limits, SVPWM -> Modulation; actuate: the PWM write (latched for the next period); protect:
+/// every trip decision -> Trip, latched, and the PWM off before the written duties act; publish:
+/// the tick record and CAN telemetry. What the PWM write does not wait for runs after it: the
+/// trip decisions, the observers advanced over the next period and the rotor-resistance
+/// tracker's step.
 /// Each stage is timed. T is the control arithmetic: float on the MCU, double on the host.
 #include <atomic>
 #include <cstdint>
@@ -145,16 +146,20 @@ class Drive final : public hal::TickHandler {
   // The service loop's side of the commissioning.
   void plan_commissioning() noexcept;
   void adopt_commissioning() noexcept;
-  /// The PWM write, or the PWM off with a fault latched; the observers learn what acts.
-  [[gnu::always_inline]] void actuate(uint64_t k, const Estimate<T>& e, const Modulation<T>& out,
-                                      const Trip& trip, MotorModel<T>* model) noexcept;
+  /// The PWM write of what the tick modulated, or the PWM off when nothing is. Returns whether
+  /// the written voltage is the law's (or DC braking's), which the observers must learn.
+  [[gnu::always_inline]] bool actuate(const Modulation<T>& out, MotorModel<T>* model) noexcept;
+  /// After the write: the faults found (and an overrun) latched, the PWM off for an STO before
+  /// the written duties act, and what acts over the next period kept for the observers.
+  [[gnu::always_inline]] void react(uint64_t k, const Estimate<T>& e, const Modulation<T>& out,
+                                    const Trip& trip, const Trip& overrun, bool law_voltage,
+                                    MotorModel<T>* model) noexcept;
   /// After the PWM write, what the write does not wait for: the observers advanced over the
   /// next period, and the rotor-resistance tracker's step (it feeds only the service loop).
   [[gnu::always_inline]] void after_write(const Measurement<T>& m, const Estimate<T>& e,
                                           const Vec2& u_acted_V, MotorModel<T>* model) noexcept;
-  /// The execution time up to the PWM write, against its budget.
-  [[gnu::always_inline]] void check_budget(uint64_t k, uint32_t counts,
-                                           MotorModel<T>* model) noexcept;
+  /// The execution time up to the PWM write, against its budget: the overrun trip, if any.
+  [[gnu::always_inline]] Trip check_budget(uint32_t counts) noexcept;
   [[gnu::always_inline]] void publish(uint64_t k, const Measurement<T>& m, const Estimate<T>& e,
                                       const TickPlan<T>& plan, const LawOutput<T>& u,
                                       const Modulation<T>& out, MotorModel<T>* model) noexcept;
