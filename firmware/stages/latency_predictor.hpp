@@ -52,11 +52,6 @@ class LatencyPredictor {
     u_in_flight_V_ = u_V;
     return acting;
   }
-  /// The tick's voltage will never act (an overrun turned the PWM off after it was written).
-  void cancel_in_flight() noexcept {
-    v_in_flight_V_ = control::Vec2<T>::Zero();
-    u_in_flight_V_ = control::Vec2<T>::Zero();
-  }
 
   /// Takes over the state of the object this one replaces (the same motor but for its
   /// rotor resistance): the tick changes coefficients and keeps state (docs/robustness.md).
