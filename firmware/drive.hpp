@@ -201,7 +201,7 @@ class Drive final : public hal::TickHandler {
   T rad_s_per_count_;  ///< an encoder count per period, as a mean speed over the period
   Vec2 v_applied_V_ = Vec2::Zero();  ///< rotor-frame input written this tick (zero if off)
   Vec2 u_last_period_V_ = Vec2::Zero();  ///< stator voltage that acted over [k-1, k]
-  // Set before the PWM write for after_write (tick side).
+  // Set after the trip decisions for after_write (tick side).
   Vec2 v_acting_V_ = Vec2::Zero();  ///< rotor-frame input acting over [k, k+1]
   bool observers_due_ = false;      ///< the observers advance with it
   bool tracker_due_ = false;        ///< the rotor-resistance tracker steps

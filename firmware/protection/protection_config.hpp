@@ -1,7 +1,7 @@
 #pragma once
-/// Protection thresholds. Every check runs each tick before the PWM write; the defaults are safe
-/// for the paper-000 motor on a 311 V bus and are overridden per board or scenario
-/// (docs/safety.md explains each check and its detection latency).
+/// Protection thresholds. Every check runs each tick, before the written duties act; the
+/// defaults are safe for the paper-000 motor on a 311 V bus and are overridden per board or
+/// scenario (docs/safety.md explains each check and its detection latency).
 #include <cstdint>
 #include <limits>
 
