@@ -86,10 +86,8 @@ void Drive<T>::on_tick() noexcept {
   // Every trip decision follows the write: hal::Pwm latches the duties for the next period, so
   // a trip that turns the PWM off in this tick keeps them from ever acting, as before the write.
   SupervisedState supervised = plan.supervised;
-  supervised.brake_may_hold =
-      config_.brake_output_line >= 0 &&
-      (!brake_line_level_ ||
-       k < brake_released_tick_ + brake_release_ticks_);
+  supervised.brake_may_hold = config_.brake_output_line >= 0 &&
+      (!brake_line_level_ || k < brake_released_tick_ + brake_release_ticks_);
   Trip trip = protection_.check(m, e, supervised, u, out, e.valid ? &model->checks : nullptr);
   // The power stage's own over-current trip already turned the outputs off: latch it.
   if (hw_.pwm.tripped()) trip.add(FaultCode::overcurrent, kHardwareTripDetail);
