@@ -1,7 +1,8 @@
 #pragma once
 /// The protect stage: every trip decision of the tick, in one place, right after the PWM write
 /// (which the PWM latches for the next period). It returns the faults found (Trip); the
-/// supervisor latches them and the PWM goes off in the same tick, before those duties act. The checks, in the order in which the first fault is named (docs/safety.md):
+/// supervisor latches them and the PWM goes off in the same tick, before those duties act. The
+/// checks, in the order in which the first fault is named (docs/safety.md):
 ///   1. the board's enable input lost while the inverter drives the motor;
 ///   2. while calibrating: an ADC offset beyond its limit;
 ///   3. in every state: over-current (or an ADC code on a rail), bus over-voltage, over-speed,
