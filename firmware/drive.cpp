@@ -17,7 +17,6 @@ std::optional<MotorModel<T>> build(const std::optional<MotorRecord>& record,
   if (!record) return std::nullopt;
   return std::optional<MotorModel<T>>(std::in_place, record->motor, config, board);
 }
-
 }  // namespace
 
 template <typename T>
@@ -205,6 +204,8 @@ inline void Drive<T>::after_write(const Measurement<T>& m, const Estimate<T>& e,
       model->observers.advance(v_acting_V_);
     }
   }
+  if (law_v_max_V_ >= T(0)) supervisor_.law().after_write(e.x_input, law_v_max_V_);
+  law_v_max_V_ = T(-1);
   if (tracker_due_) {
     tracker_due_ = false;
     model->rotor_resistance.step(m.i_alphabeta_A, e.x.i_s_AB_A, e.x.omega_mech_rad_s,
@@ -229,10 +230,9 @@ inline LawOutput<T> Drive<T>::law(const TickPlan<T>& plan, const Estimate<T>& e,
   if (plan.mode == Mode::magnetizing) {
     return model->magnetizer.step(e.x_input, plan.next, supervisor_.controlled_flux(), feasible);
   }
-  const LawOutput<T> out =
-      supervisor_.law().step({e, plan.now, plan.next, plan.ahead, plan.stopping, feasible,
-                              model->limits.v_max_V(v_bus_V)},
-                             record_.law);
+  law_v_max_V_ = model->limits.v_max_V(v_bus_V);
+  const LawOutput<T> out = supervisor_.law().step(
+      {e, plan.now, plan.next, plan.ahead, plan.stopping, feasible, law_v_max_V_}, record_.law);
   if (record_.law.limit == Limitation::input) {
     record_.law.limit = model->limits.binding(e.x_input, v_bus_V, out.v_AB_V);
   }

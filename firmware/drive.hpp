@@ -155,7 +155,8 @@ class Drive final : public hal::TickHandler {
                                     const Trip& trip, const Trip& overrun, bool law_voltage,
                                     MotorModel<T>* model) noexcept;
   /// After the PWM write, what the write does not wait for: the observers advanced over the
-  /// next period, and the rotor-resistance tracker's step (it feeds only the service loop).
+  /// next period, the law's work for the next tick, and the rotor-resistance tracker's step
+  /// (it feeds only the service loop).
   [[gnu::always_inline]] void after_write(const Measurement<T>& m, const Estimate<T>& e,
                                           const Vec2& u_acted_V, MotorModel<T>* model) noexcept;
   /// The execution time up to the PWM write, against its budget: the overrun trip, if any.
@@ -206,6 +207,7 @@ class Drive final : public hal::TickHandler {
   bool observers_due_ = false;      ///< the observers advance with it
   bool tracker_due_ = false;        ///< the rotor-resistance tracker steps
   bool tracker_adapts_ = false;     ///< and may move its estimate
+  T law_v_max_V_ = T(-1);           ///< the law stepped on this disk (< 0: it did not)
   bool fault_line_level_ = false;
   bool brake_line_level_ = false;  ///< released (driven) or engaged
   uint64_t brake_released_tick_ = 0;  ///< when the line last released the brake

@@ -78,6 +78,13 @@ class ControlLaw {
     (void)i_AB_A;
   }
   virtual LawOutput<T> step(const LawInput<T>& in, LawDiagnostics<T>& report) noexcept = 0;
+  /// After the PWM write, on the state x_input this tick's step acted on and its voltage disk:
+  /// what the next step needs but this one's output does not wait for (a limit that moves with
+  /// the speed), off the latency from sense to write.
+  virtual void after_write(const control::RotorFrameState<T>& x_input, T v_max_V) noexcept {
+    (void)x_input;
+    (void)v_max_V;
+  }
 };
 
 }  // namespace imd::firmware
