@@ -16,6 +16,7 @@
 /// output is the stator voltage there. Tick context except construction.
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "control/field_weakening.hpp"
 #include "control/flux_frame_current_loop.hpp"
@@ -79,6 +80,7 @@ class Ifoc {
     const Vec2<T> i_dq = flux_model_.frame().apply_inverse(i_AB_A);
     current_loop_.reset(i_dq);
     speed_pi_.reset();
+    flux_limit_Wb_ = std::numeric_limits<T>::infinity();
   }
 
   IfocOutput<T> step(const IfocInput<T>& in) noexcept {
@@ -90,13 +92,12 @@ class Ifoc {
     const T flux = std::max(flux_model_.flux_Wb(), min_flux_);
     const T omega_e = p_ * in.omega_mech_rad_s + flux_model_.slip_rad_s();
 
-    // Flux: the reference, or what the voltage allows above base speed with the torque current
-    // flowing, but never less than the flux of the most torque per volt (less flux would ask
-    // for more current and lower the limit again).
-    const T v_fw = fw_share_ * in.v_max_V;
-    const T flux_limit = std::max(voltage_limited_flux_Wb(fw_motor_, omega_e, i_dq.y(), v_fw),
-                                  max_torque_per_volt_flux_Wb(fw_motor_, omega_e, v_fw));
-    out.flux_ref_Wb = std::max(std::min(in.flux_ref_Wb, flux_limit), min_flux_);
+    // Flux: the reference, or what the voltage allows above base speed (field weakening's
+    // limit, from the last step's speed and torque current: update_field_weakening).
+    fw_omega_e_ = omega_e;
+    fw_i_q_ = i_dq.y();
+    fw_v_ = fw_share_ * in.v_max_V;
+    out.flux_ref_Wb = std::max(std::min(in.flux_ref_Wb, flux_limit_Wb_), min_flux_);
     const T i_d_ref = std::min(out.flux_ref_Wb / Lm_, i_limit_);
 
     // Torque: speed PI with feed-forward, then the current left beside i_d.
@@ -130,6 +131,15 @@ class Ifoc {
     return out;
   }
 
+  /// After the step's output is written: field weakening's limit for the next step, what the
+  /// voltage allows with the step's torque current flowing, but never less than the flux of
+  /// the most torque per volt (less flux would ask for more current and lower the limit
+  /// again). One period late on a speed and a current that move over milliseconds.
+  void update_field_weakening() noexcept {
+    flux_limit_Wb_ = std::max(voltage_limited_flux_Wb(fw_motor_, fw_omega_e_, fw_i_q_, fw_v_),
+                              max_torque_per_volt_flux_Wb(fw_motor_, fw_omega_e_, fw_v_));
+  }
+
   const RotorFluxModel<T>& flux_model() const noexcept { return flux_model_; }
   const SpeedPi<T>& speed_pi() const noexcept { return speed_pi_; }
 
@@ -139,6 +149,7 @@ class Ifoc {
     flux_model_.continue_from(old.flux_model_);
     speed_pi_.continue_from(old.speed_pi_);
     current_loop_.continue_from(old.current_loop_);
+    flux_limit_Wb_ = old.flux_limit_Wb_;
   }
 
  private:
@@ -149,6 +160,8 @@ class Ifoc {
   T J_over_T_, friction_, i_limit_, min_flux_, fw_share_;
   FieldWeakeningMotor<T> fw_motor_;
   int latency_ticks_;
+  T flux_limit_Wb_ = std::numeric_limits<T>::infinity();  ///< field weakening's, next step
+  T fw_omega_e_ = T(0), fw_i_q_ = T(0), fw_v_ = T(0);     ///< this step's, for the next limit
 };
 
 }  // namespace imd::control

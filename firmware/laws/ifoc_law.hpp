@@ -79,6 +79,12 @@ class IfocLaw final : public ControlLaw<T> {
     return result;
   }
 
+  void after_write(const control::RotorFrameState<T>& x_input, T v_max_V) noexcept override {
+    (void)x_input;  // the step kept what its field weakening needs
+    (void)v_max_V;
+    ifoc_.update_field_weakening();
+  }
+
   /// Takes over the state of the object this one replaces (the same motor but for its
   /// rotor resistance): the tick changes coefficients and keeps state (docs/robustness.md).
   void continue_from(const IfocLaw& old) noexcept {

@@ -219,6 +219,7 @@ TEST(Ifoc, SlipAndFluxAngleMatchTheMotorInSteadyState) {
       in.omega_mech_rad_s = motor.x().omega_mech_rad_s;
       flux_angle_before = std::atan2(motor.x().flux_r_AB_Wb.y(), motor.x().flux_r_AB_Wb.x());
       motor.step(ifoc.step(in).u_AB_V, load);
+      ifoc.update_field_weakening();  // as the drive does after its PWM write
     }
     const Vec2<double> flux = motor.x().flux_r_AB_Wb;
     const double true_angle = std::atan2(flux.y(), flux.x());
@@ -298,6 +299,7 @@ TEST(Ifoc, AboveBaseSpeedTheFluxSettlesWhereTheVoltageRunsOut) {
       const IfocOutput<double> out = ifoc.step(in);
       ASSERT_LE(out.u_AB_V.norm(), v_max * (1 + 1e-12));
       motor.step(out.u_AB_V, 0.0);
+      ifoc.update_field_weakening();  // as the drive does after its PWM write
     }
     // The flux the controller asks for is what the voltage allows there (0.9 of the disk by
     // design), well below the reference, and the motor follows it and the speed.
