@@ -73,7 +73,7 @@ void Drive<T>::on_tick() noexcept {
   const TickPlan<T> plan = supervisor_.plan(k, m, e);
   // A hardware trip is forgotten only when its fault is cleared (and found again at once if
   // the comparator still holds the break input).
-  if (plan.supervised.restarted) hw_.pwm.clear_trip();
+  if (plan.restarted) hw_.pwm.clear_trip();
   clock.lap(Stage::supervise);
   const LawOutput<T> u = law(plan, e, m.v_bus_V, model);
   clock.lap(Stage::law);
@@ -84,7 +84,7 @@ void Drive<T>::on_tick() noexcept {
   if (hw_.watchdog != nullptr) hw_.watchdog->feed();  // the PWM is written: the tick lives
   // Every trip decision follows the write: hal::Pwm latches the duties for the next period, so
   // a trip that turns the PWM off in this tick keeps them from ever acting, as before the write.
-  SupervisedState supervised = plan.supervised;
+  SupervisedState supervised = supervisor_.supervised(k, plan);
   supervised.brake_may_hold = config_.brake_output_line >= 0 &&
       (!brake_line_level_ || k < brake_released_tick_ + brake_release_ticks_);
   Trip trip = protection_.check(m, e, supervised, u, out, e.valid ? &model->checks : nullptr);
@@ -233,9 +233,6 @@ inline LawOutput<T> Drive<T>::law(const TickPlan<T>& plan, const Estimate<T>& e,
   law_v_max_V_ = model->limits.v_max_V(v_bus_V);
   const LawOutput<T> out = supervisor_.law().step(
       {e, plan.now, plan.next, plan.ahead, plan.stopping, feasible, law_v_max_V_}, record_.law);
-  if (record_.law.limit == Limitation::input) {
-    record_.law.limit = model->limits.binding(e.x_input, v_bus_V, out.v_AB_V);
-  }
   return out;
 }
 
@@ -347,6 +344,9 @@ inline void Drive<T>::publish(uint64_t k, const Measurement<T>& m, const Estimat
   DriveStatus& status = supervisor_.status();
   status.state = supervisor_.state();
   if (status.state == DriveState::running) {
+    if (record_.law.limit == Limitation::input && model != nullptr) {  // which limit binds
+      record_.law.limit = model->limits.binding(e.x_input, m.v_bus_V, u.v_AB_V);
+    }
     limited_.update(record_.law.limit);
   } else {
     limited_.reset();  // stopping, stopped or faulted: nothing to reach

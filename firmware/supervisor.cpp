@@ -155,7 +155,13 @@ TickPlan<T> Supervisor<T>::plan(uint64_t k, const Measurement<T>& m,
   } else if (e.valid) {
     p.next = references_.at_tick(k);  // what the drive would aim at once enabled
   }
-  SupervisedState& s = p.supervised;
+  return p;
+}
+
+template <typename T>
+SupervisedState Supervisor<T>::supervised(uint64_t k, const TickPlan<T>& p) const noexcept {
+  SupervisedState s;
+  s.restarted = p.restarted;
   s.modulating = modulating();
   s.enable_input = enable_input_;
   s.magnetizing = machine_.state() == DriveState::magnetizing;
@@ -164,7 +170,7 @@ TickPlan<T> Supervisor<T>::plan(uint64_t k, const Measurement<T>& m,
   s.watchdog_armed = commands_over_can_ && (machine_.state() == DriveState::magnetizing ||
                                             machine_.state() == DriveState::running);
   s.command_silence_ticks = saturated_ticks(k - last_command_tick_);
-  return p;
+  return s;
 }
 
 template <typename T>

@@ -52,7 +52,7 @@ struct TickPlan {
   /// References at the input's step and the step after (the speed through the ramp), and the
   /// law's lookahead; while off, `next` is the reference of this tick (for telemetry).
   Reference<T> now, next, ahead;
-  SupervisedState supervised;  ///< for the checks
+  bool restarted = false;  ///< enabled or cleared this tick: the checks start afresh
 };
 
 /// Where the supervisor's commands and events go.
@@ -80,6 +80,9 @@ class Supervisor {
   /// Commands, then the transitions the measurement and the estimate call for, then the
   /// references.
   TickPlan<T> plan(uint64_t k, const Measurement<T>& m, const Estimate<T>& e) noexcept;
+  /// What the checks need of tick k's plan p, after the PWM write (off the latency from sense
+  /// to write; nothing between the plan and the checks changes the state).
+  SupervisedState supervised(uint64_t k, const TickPlan<T>& p) const noexcept;
   /// Latches the faults the protect stage found (the first one keeps its code and time) and
   /// starts their stop (firmware/protection/stop_category.hpp). True: STO, the caller turns the
   /// PWM off now; false: a controlled stop (SS1 or DC braking) runs, or continues, first.

@@ -33,7 +33,7 @@ void Supervisor<T>::enable(uint64_t k, TickPlan<T>& p) noexcept {
   magnetizing_start_tick_ = k;
   last_command_tick_ = k;
   ramp_.set_max_step(command_accel_step_rad_s_);
-  p.supervised.restarted = true;
+  p.restarted = true;
 }
 
 template <typename T>
@@ -48,7 +48,7 @@ protocol::CommandResult Supervisor<T>::clear_faults(uint64_t k, TickPlan<T>& p) 
   status_.first_fault = FaultCode::none;
   status_.fault_detail = 0;
   status_.stop = StopCategory::none;
-  p.supervised.restarted = true;
+  p.restarted = true;
   return protocol::CommandResult::accepted;
 }
 

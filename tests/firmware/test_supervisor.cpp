@@ -62,8 +62,8 @@ TEST(Supervisor, MagnetizesUntilTheFluxReachesItsShareThenRuns) {
   b.flux(0.3);  // 0.09 Wb^2, below 0.95 x 0.2
   TickPlan<double> p = b.supervisor.plan(1, b.m, b.e);
   EXPECT_EQ(p.mode, Mode::magnetizing);
-  EXPECT_TRUE(p.supervised.magnetizing);
-  EXPECT_EQ(p.supervised.magnetizing_ticks, 1u);
+  EXPECT_TRUE(b.supervisor.supervised(1, p).magnetizing);
+  EXPECT_EQ(b.supervisor.supervised(1, p).magnetizing_ticks, 1u);
   b.flux(std::sqrt(0.95 * 0.2) * (1 + 1e-9));  // just past 0.95 x 0.2 Wb^2
   p = b.supervisor.plan(2, b.m, b.e);
   EXPECT_EQ(b.supervisor.state(), DriveState::running);
