@@ -80,7 +80,7 @@ class Ifoc {
     const Vec2<T> i_dq = flux_model_.frame().apply_inverse(i_AB_A);
     current_loop_.reset(i_dq);
     speed_pi_.reset();
-    flux_limit_Wb_ = std::numeric_limits<T>::infinity();
+    fw_updated_ = false;
   }
 
   IfocOutput<T> step(const IfocInput<T>& in) noexcept {
@@ -97,6 +97,8 @@ class Ifoc {
     fw_omega_e_ = omega_e;
     fw_i_q_ = i_dq.y();
     fw_v_ = fw_share_ * in.v_max_V;
+    if (!fw_updated_) update_field_weakening();  // not updated since the last step: now
+    fw_updated_ = false;
     out.flux_ref_Wb = std::max(std::min(in.flux_ref_Wb, flux_limit_Wb_), min_flux_);
     const T i_d_ref = std::min(out.flux_ref_Wb / Lm_, i_limit_);
 
@@ -131,13 +133,16 @@ class Ifoc {
     return out;
   }
 
-  /// After the step's output is written: field weakening's limit for the next step, what the
-  /// voltage allows with the step's torque current flowing, but never less than the flux of
-  /// the most torque per volt (less flux would ask for more current and lower the limit
-  /// again). One period late on a speed and a current that move over milliseconds.
+  /// Field weakening's limit for the next step: what the voltage allows with the last step's
+  /// torque current flowing at its speed, but never less than the flux of the most torque per
+  /// volt (less flux would ask for more current and lower the limit again). A drive calls it
+  /// after the PWM write, off the latency to the write: the limit is then one period late on a
+  /// speed and a current that move over milliseconds. A step that finds it not called since
+  /// the last step (the first one, or a caller that never does) computes it itself.
   void update_field_weakening() noexcept {
     flux_limit_Wb_ = std::max(voltage_limited_flux_Wb(fw_motor_, fw_omega_e_, fw_i_q_, fw_v_),
                               max_torque_per_volt_flux_Wb(fw_motor_, fw_omega_e_, fw_v_));
+    fw_updated_ = true;
   }
 
   const RotorFluxModel<T>& flux_model() const noexcept { return flux_model_; }
@@ -150,6 +155,7 @@ class Ifoc {
     speed_pi_.continue_from(old.speed_pi_);
     current_loop_.continue_from(old.current_loop_);
     flux_limit_Wb_ = old.flux_limit_Wb_;
+    fw_updated_ = old.fw_updated_;
   }
 
  private:
@@ -162,6 +168,7 @@ class Ifoc {
   int latency_ticks_;
   T flux_limit_Wb_ = std::numeric_limits<T>::infinity();  ///< field weakening's, next step
   T fw_omega_e_ = T(0), fw_i_q_ = T(0), fw_v_ = T(0);     ///< this step's, for the next limit
+  bool fw_updated_ = false;  ///< the limit was updated since the last step
 };
 
 }  // namespace imd::control

@@ -70,11 +70,16 @@ class DsmcLaw final : public ControlLaw<T> {
   }
 
   /// Takes over the field-weakening limit of the law it replaces.
-  void continue_from(const DsmcLaw& old) noexcept { flux2_limit_Wb2_ = old.flux2_limit_Wb2_; }
-  void start(const control::RotorFrameState<T>& x, const control::Vec2<T>& i_AB_A) noexcept override {
+  void continue_from(const DsmcLaw& old) noexcept {
+    flux2_limit_Wb2_ = old.flux2_limit_Wb2_;
+    limit_updated_ = old.limit_updated_;
+  }
+  void start(const control::RotorFrameState<T>& x,
+             const control::Vec2<T>& i_AB_A) noexcept override {
     (void)x;
     (void)i_AB_A;
     flux2_limit_Wb2_ = std::numeric_limits<T>::infinity();
+    limit_updated_ = false;
   }
 
   ControlledFlux controlled_flux() const noexcept override { return ControlledFlux::rotor; }
@@ -83,29 +88,18 @@ class DsmcLaw final : public ControlLaw<T> {
   /// Field weakening: above base speed the squared-flux reference falls to what the voltage
   /// allows in steady state with the torque current flowing, never below the flux of the most
   /// torque per volt (control/field_weakening.hpp, the IFOC's rule), with a tenth of the disk
-  /// left to the transients. Computed after the PWM write on this tick's state, for the next
-  /// tick: a limit one period (0.1 ms) late on a speed and a torque current that move over
-  /// milliseconds, and the disk bounds each tick's voltage anyway.
+  /// left to the transients. The drive updates it after the PWM write on this tick's state, for
+  /// the next tick: a limit one period (0.1 ms) late on a speed and a torque current that move
+  /// over milliseconds, and the disk bounds each tick's voltage anyway. A step that finds it
+  /// not updated since the last step (the first one) computes it itself.
   void after_write(const control::RotorFrameState<T>& x_input, T v_max_V) noexcept override {
-    const control::Vec2<T>& flux_AB = x_input.flux_r_AB_Wb;
-    const T flux_Wb = std::max(flux_AB.norm(), min_flux_Wb_);
-    const T i_q =
-        (flux_AB.x() * x_input.i_s_AB_A.y() - flux_AB.y() * x_input.i_s_AB_A.x()) / flux_Wb;
-    const T omega_e = p_ * x_input.omega_mech_rad_s + slip_per_A_ * i_q / flux_Wb;
-    const T v_fw = T(control::kFieldWeakeningVoltageShare) * v_max_V;
-    const T flux_limit =
-        std::max(control::voltage_limited_flux_Wb(fw_motor_, omega_e, i_q, v_fw),
-                 control::max_torque_per_volt_flux_Wb(fw_motor_, omega_e, v_fw));
-    // The limit falls at once, and rises no faster than the rotor flux can follow, twice the
-    // rotor's rate: at the end of a ramp the torque current drops and the limit jumps up, and
-    // a flux reference that jumped with it would take the whole voltage for the flux and turn
-    // the torque round (the flux channel has priority on the disk).
-    const T allowed = std::max(flux2_limit_Wb2_, min_flux2_) * (T(1) + flux2_rise_per_tick_);
-    flux2_limit_Wb2_ = std::min(std::max(flux_limit * flux_limit, min_flux2_), allowed);
+    update_field_weakening(x_input, v_max_V);
   }
 
   LawOutput<T> step(const LawInput<T>& in, LawDiagnostics<T>& report) noexcept override {
-    const T flux2_limit = flux2_limit_Wb2_;  // the last after_write's (none on the first tick)
+    if (!limit_updated_) update_field_weakening(in.e.x_input, in.v_max_V);
+    limit_updated_ = false;
+    const T flux2_limit = flux2_limit_Wb2_;
     report.flux_ref_Wb = std::sqrt(std::min(in.next.flux2_Wb2, flux2_limit));
 
     control::DsmcInput<T> d;
@@ -134,12 +128,32 @@ class DsmcLaw final : public ControlLaw<T> {
   }
 
  private:
+  void update_field_weakening(const control::RotorFrameState<T>& x_input, T v_max_V) noexcept {
+    const control::Vec2<T>& flux_AB = x_input.flux_r_AB_Wb;
+    const T flux_Wb = std::max(flux_AB.norm(), min_flux_Wb_);
+    const T i_q =
+        (flux_AB.x() * x_input.i_s_AB_A.y() - flux_AB.y() * x_input.i_s_AB_A.x()) / flux_Wb;
+    const T omega_e = p_ * x_input.omega_mech_rad_s + slip_per_A_ * i_q / flux_Wb;
+    const T v_fw = T(control::kFieldWeakeningVoltageShare) * v_max_V;
+    const T flux_limit =
+        std::max(control::voltage_limited_flux_Wb(fw_motor_, omega_e, i_q, v_fw),
+                 control::max_torque_per_volt_flux_Wb(fw_motor_, omega_e, v_fw));
+    // The limit falls at once, and rises no faster than the rotor flux can follow, twice the
+    // rotor's rate: at the end of a ramp the torque current drops and the limit jumps up, and
+    // a flux reference that jumped with it would take the whole voltage for the flux and turn
+    // the torque round (the flux channel has priority on the disk).
+    const T allowed = std::max(flux2_limit_Wb2_, min_flux2_) * (T(1) + flux2_rise_per_tick_);
+    flux2_limit_Wb2_ = std::min(std::max(flux_limit * flux_limit, min_flux2_), allowed);
+    limit_updated_ = true;
+  }
+
   control::Dsmc<T> dsmc_;
   control::FieldWeakeningMotor<T> fw_motor_;
   T p_, slip_per_A_, min_flux2_;
   T flux2_rise_per_tick_;  ///< 2 delta / tau_r
   T min_flux_Wb_ = std::sqrt(min_flux2_);  ///< once, not per tick (after min_flux2_)
   T flux2_limit_Wb2_ = std::numeric_limits<T>::infinity();  ///< field weakening's, next tick
+  bool limit_updated_ = false;  ///< since the last step
 };
 
 }  // namespace imd::firmware

@@ -270,46 +270,55 @@ TEST(FieldWeakening, TheLimitFluxNeedsExactlyTheVoltageAndFallsAsOneOverSpeed) {
   }
 }
 
+// A ramp to twice base speed, the field-weakening limit updated after each step as the drive
+// does after its PWM write (one period late), or never, each step then computing its own.
+void RampToTwiceBaseSpeed(const test::TestMotor& t, bool updated_after_step) {
+  const IfocGains g = design_ifoc(t.parameters, spec_without_latency(t));
+  Ifoc<double> ifoc(g);
+  ExactMotor motor(t.parameters);
+  const double flux_ref = t.flux_Wb, v_max = t.voltage_V;
+  motor.magnetize(flux_ref / g.Lm_H, g.Lm_H);
+  ifoc.start(motor.x().flux_r_AB_Wb, motor.x().i_s_AB_A);
+  const double base_mech = v_max / (t.parameters.Ls_H * flux_ref / g.Lm_H) / g.pole_pairs;
+  IfocInput<double> in;
+  in.flux_ref_Wb = flux_ref;
+  in.v_max_V = v_max;
+  in.u_feasible_AB_V = {Vec2<double>::Zero(), v_max};
+  const double tau_r = t.parameters.Lr_H / t.parameters.Rr_Ohm;
+  // A ramp slow enough that its torque is a fifth of the motor's typical load: the voltage the
+  // torque current needs stays within the tenth of the disk left to it.
+  const double target = 2.0 * base_mech;
+  const double ramp_s = t.parameters.J_kgm2 * target / (0.2 * t.load_Nm);
+  const int ramp_ticks = static_cast<int>(ramp_s / kPeriod_s);
+  const int ticks =
+      ramp_ticks + static_cast<int>((10 * tau_r + 100 / g.speed_bandwidth_rad_s) / kPeriod_s);
+  for (int k = 0; k < ticks; ++k) {  // a ramp to twice base speed, then hold
+    in.omega_ref_rad_s = target * std::min(1.0, double(k) / ramp_ticks);
+    in.omega_ref_next_rad_s = target * std::min(1.0, double(k + 1) / ramp_ticks);
+    in.i_now_AB_A = in.i_input_AB_A = motor.x().i_s_AB_A;
+    in.omega_mech_rad_s = motor.x().omega_mech_rad_s;
+    const IfocOutput<double> out = ifoc.step(in);
+    ASSERT_LE(out.u_AB_V.norm(), v_max * (1 + 1e-12));
+    motor.step(out.u_AB_V, 0.0);
+    if (updated_after_step) ifoc.update_field_weakening();
+  }
+  // The flux the controller asks for is what the voltage allows there (0.9 of the disk by
+  // design), well below the reference, and the motor follows it and the speed.
+  const double w_e = g.pole_pairs * target;
+  const double expected = voltage_limited_flux_Wb(
+      FieldWeakeningMotor<double>{g.Rs_Ohm, g.Ls_H, g.sigma_H, g.Lm_H}, w_e, 0.0,
+      g.field_weakening_voltage_share * v_max);
+  EXPECT_LT(expected, 0.6 * flux_ref);
+  EXPECT_NEAR(motor.x().flux_r_AB_Wb.norm(), expected, 0.02 * expected);
+  EXPECT_NEAR(motor.x().omega_mech_rad_s, target, 1e-3 * target);
+}
+
 TEST(Ifoc, AboveBaseSpeedTheFluxSettlesWhereTheVoltageRunsOut) {
-  for (const test::TestMotor& t : test::test_motors()) {
-    SCOPED_TRACE(t.name);
-    const IfocGains g = design_ifoc(t.parameters, spec_without_latency(t));
-    Ifoc<double> ifoc(g);
-    ExactMotor motor(t.parameters);
-    const double flux_ref = t.flux_Wb, v_max = t.voltage_V;
-    motor.magnetize(flux_ref / g.Lm_H, g.Lm_H);
-    ifoc.start(motor.x().flux_r_AB_Wb, motor.x().i_s_AB_A);
-    const double base_mech = v_max / (t.parameters.Ls_H * flux_ref / g.Lm_H) / g.pole_pairs;
-    IfocInput<double> in;
-    in.flux_ref_Wb = flux_ref;
-    in.v_max_V = v_max;
-    in.u_feasible_AB_V = {Vec2<double>::Zero(), v_max};
-    const double tau_r = t.parameters.Lr_H / t.parameters.Rr_Ohm;
-    // A ramp slow enough that its torque is a fifth of the motor's typical load: the voltage the
-    // torque current needs stays within the tenth of the disk left to it.
-    const double target = 2.0 * base_mech;
-    const double ramp_s = t.parameters.J_kgm2 * target / (0.2 * t.load_Nm);
-    const int ramp_ticks = static_cast<int>(ramp_s / kPeriod_s);
-    const int ticks = ramp_ticks + static_cast<int>((10 * tau_r + 100 / g.speed_bandwidth_rad_s) / kPeriod_s);
-    for (int k = 0; k < ticks; ++k) {  // a ramp to twice base speed, then hold
-      in.omega_ref_rad_s = target * std::min(1.0, double(k) / ramp_ticks);
-      in.omega_ref_next_rad_s = target * std::min(1.0, double(k + 1) / ramp_ticks);
-      in.i_now_AB_A = in.i_input_AB_A = motor.x().i_s_AB_A;
-      in.omega_mech_rad_s = motor.x().omega_mech_rad_s;
-      const IfocOutput<double> out = ifoc.step(in);
-      ASSERT_LE(out.u_AB_V.norm(), v_max * (1 + 1e-12));
-      motor.step(out.u_AB_V, 0.0);
-      ifoc.update_field_weakening();  // as the drive does after its PWM write
+  for (const bool updated_after_step : {true, false}) {
+    for (const test::TestMotor& t : test::test_motors()) {
+      SCOPED_TRACE(t.name + (updated_after_step ? ", updated after each step" : ", never updated"));
+      RampToTwiceBaseSpeed(t, updated_after_step);
     }
-    // The flux the controller asks for is what the voltage allows there (0.9 of the disk by
-    // design), well below the reference, and the motor follows it and the speed.
-    const double w_e = g.pole_pairs * target;
-    const double expected = voltage_limited_flux_Wb(
-        FieldWeakeningMotor<double>{g.Rs_Ohm, g.Ls_H, g.sigma_H, g.Lm_H}, w_e, 0.0,
-        g.field_weakening_voltage_share * v_max);
-    EXPECT_LT(expected, 0.6 * flux_ref);
-    EXPECT_NEAR(motor.x().flux_r_AB_Wb.norm(), expected, 0.02 * expected);
-    EXPECT_NEAR(motor.x().omega_mech_rad_s, target, 1e-3 * target);
   }
 }
 
