@@ -43,7 +43,9 @@ protocol::CommandResult Supervisor<T>::clear_faults(uint64_t k, TickPlan<T>& p) 
   if (machine_.state() != DriveState::fault) return protocol::CommandResult::accepted;
   // A fault during the offset calibration leaves the offsets unknown: calibrate again.
   const DriveState next = calibrated_ ? rest_state() : DriveState::calibrating;
-  if (!machine_.go(next, TransitionReason::clear_faults, k)) return protocol::CommandResult::accepted;
+  if (!machine_.go(next, TransitionReason::clear_faults, k)) {
+    return protocol::CommandResult::accepted;
+  }
   status_.fault_bits = 0;
   status_.first_fault = FaultCode::none;
   status_.fault_detail = 0;
