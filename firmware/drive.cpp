@@ -92,7 +92,7 @@ void Drive<T>::on_tick() noexcept {
   if (hw_.pwm.tripped()) trip.add(FaultCode::overcurrent, kHardwareTripDetail);
   react(k, e, out, trip, overrun, law_voltage, model);
   clock.lap(Stage::protect);
-  after_write(m, e, u_acted_V, model);
+  after_write(m, e, plan.mode == Mode::controlling && model != nullptr, u_acted_V, model);
   publish(k, m, e, plan, u, out, model);
   end_identification(k);
   if (bank_.apply_wanted()) release_model();
@@ -193,7 +193,8 @@ inline Estimate<T> Drive<T>::estimate(const Measurement<T>& m, MotorModel<T>* mo
 
 template <typename T>
 inline void Drive<T>::after_write(const Measurement<T>& m, const Estimate<T>& e,
-                                  const Vec2& u_acted_V, MotorModel<T>* model) noexcept {
+                                  bool law_stepped, const Vec2& u_acted_V,
+                                  MotorModel<T>* model) noexcept {
   if (observers_due_) {  // the observers advance over [k, k+1] with the input acting on it
     observers_due_ = false;
     if (substitutes_.estimator != nullptr) {
@@ -204,8 +205,7 @@ inline void Drive<T>::after_write(const Measurement<T>& m, const Estimate<T>& e,
       model->observers.advance(v_acting_V_);
     }
   }
-  if (law_v_max_V_ >= T(0)) supervisor_.law().after_write(e.x_input, law_v_max_V_);
-  law_v_max_V_ = T(-1);
+  if (law_stepped) supervisor_.law().after_write(e.x_input, model->limits.v_max_V(m.v_bus_V));
   if (tracker_due_) {
     tracker_due_ = false;
     model->rotor_resistance.step(m.i_alphabeta_A, e.x.i_s_AB_A, e.x.omega_mech_rad_s,
@@ -230,9 +230,9 @@ inline LawOutput<T> Drive<T>::law(const TickPlan<T>& plan, const Estimate<T>& e,
   if (plan.mode == Mode::magnetizing) {
     return model->magnetizer.step(e.x_input, plan.next, supervisor_.controlled_flux(), feasible);
   }
-  law_v_max_V_ = model->limits.v_max_V(v_bus_V);
+  const T v_max_V = model->limits.v_max_V(v_bus_V);
   const LawOutput<T> out = supervisor_.law().step(
-      {e, plan.now, plan.next, plan.ahead, plan.stopping, feasible, law_v_max_V_}, record_.law);
+      {e, plan.now, plan.next, plan.ahead, plan.stopping, feasible, v_max_V}, record_.law);
   return out;
 }
 

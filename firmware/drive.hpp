@@ -156,9 +156,10 @@ class Drive final : public hal::TickHandler {
                                     MotorModel<T>* model) noexcept;
   /// After the PWM write, what the write does not wait for: the observers advanced over the
   /// next period, the law's work for the next tick, and the rotor-resistance tracker's step
-  /// (it feeds only the service loop).
+  /// (it feeds only the service loop). `law_stepped`: this tick's law() stepped the law.
   [[gnu::always_inline]] void after_write(const Measurement<T>& m, const Estimate<T>& e,
-                                          const Vec2& u_acted_V, MotorModel<T>* model) noexcept;
+                                          bool law_stepped, const Vec2& u_acted_V,
+                                          MotorModel<T>* model) noexcept;
   /// The execution time up to the PWM write, against its budget: the overrun trip, if any.
   [[gnu::always_inline]] Trip check_budget(uint32_t counts) noexcept;
   [[gnu::always_inline]] void publish(uint64_t k, const Measurement<T>& m, const Estimate<T>& e,
@@ -207,7 +208,6 @@ class Drive final : public hal::TickHandler {
   bool observers_due_ = false;      ///< the observers advance with it
   bool tracker_due_ = false;        ///< the rotor-resistance tracker steps
   bool tracker_adapts_ = false;     ///< and may move its estimate
-  T law_v_max_V_ = T(-1);           ///< the law stepped on this disk (< 0: it did not)
   bool fault_line_level_ = false;
   bool brake_line_level_ = false;  ///< released (driven) or engaged
   uint64_t brake_released_tick_ = 0;  ///< when the line last released the brake
