@@ -119,7 +119,7 @@ endfunction()
 # imd_optimize_for_size(DIRECTORY dir SOURCES src...): compile these sources of the library in
 # dir with -Os on the MCU: code that runs in the main loop (the model build, the laws' designs,
 # the parameter record) or only while commissioning, never in a running drive's tick, which
-# stays -O2 (docs/performance-mcu.md, "Flash and RAM of the board image").
+# stays -O2 (docs/performance-image.md, "Flash and RAM of the board image").
 function(imd_optimize_for_size)
   cmake_parse_arguments(ARG "" "DIRECTORY" "SOURCES" ${ARGN})
   list(TRANSFORM ARG_SOURCES PREPEND ${ARG_DIRECTORY}/)  # relative paths would name this dir's

@@ -1,4 +1,4 @@
-// The full fault matrix (docs/safety.md, "Fault matrix"): every fault the simulated board can
+// The full fault matrix (docs/safety-testing.md, "Fault matrix"): every fault the simulated board can
 // suffer x every law x double and float. The host drives the realistic paper-000 board over
 // CAN (enable, set_speed 60 rad/s every 50 ms) under a 0.5 N m active load, with a 5 N m
 // holding brake. Each case checks the fault's code and detection time, its stop (the PWM off in

@@ -1,5 +1,5 @@
 // soak: a long simulated run under a random host and random faults, checking invariants every
-// tick (tools/soak/soak_host.hpp; docs/safety.md, "Soak"). Exit code 0 when no invariant was
+// tick (tools/soak/soak_host.hpp; docs/safety-testing.md, "Soak"). Exit code 0 when no invariant was
 // violated and the heap did not grow beyond the run's own fault log, 1 otherwise, 2 on bad
 // arguments.
 #include <imd_version.hpp>

@@ -1,5 +1,5 @@
 #pragma once
-// The soak test's host (docs/safety.md, "Soak"): from a seed, it drives a simulated board the
+// The soak test's host (docs/safety-testing.md, "Soak"): from a seed, it drives a simulated board the
 // way a careless host and a hostile plant would, for as long as asked, and checks invariants
 // every tick. Each segment (0.5 to 4 s) it takes one action at random:
 //   * a new speed command (within 0.8 of base speed either way) or flux command,
