@@ -28,8 +28,12 @@ set(IMD_INSTALL_PYTHONDIR lib/python3/dist-packages)
 # an installed tree works under any prefix, and fall back to the source tree.
 file(RELATIVE_PATH imd_data_from_bin /prefix/${CMAKE_INSTALL_BINDIR}
      /prefix/${IMD_INSTALL_DATADIR})
-target_compile_definitions(drive_sim PRIVATE IMD_DATA_DIR_FROM_BIN="${imd_data_from_bin}")
 target_compile_definitions(soak PRIVATE IMD_DATA_DIR_FROM_BIN="${imd_data_from_bin}")
+# Without the host tools (the asan preset) there is no package to make.
+if(NOT IMD_BUILD_HOST_TOOLS)
+  return()
+endif()
+target_compile_definitions(drive_sim PRIVATE IMD_DATA_DIR_FROM_BIN="${imd_data_from_bin}")
 
 set(imd_tools drive_sim drive_monitor drive_hil dbc_gen drive_model soak scenario_embed)
 foreach(tool IN LISTS imd_tools)
