@@ -1,11 +1,10 @@
-// The full fault matrix (docs/safety-testing.md, "Fault matrix"): every fault the simulated board can
-// suffer x every law x double and float. The host drives the realistic paper-000 board over
-// CAN (enable, set_speed 60 rad/s every 50 ms) under a 0.5 N m active load, with a 5 N m
-// holding brake. Each case checks the fault's code and detection time, its stop (the PWM off in
-// the detecting tick for STO, later for a controlled stop), the brake line at STO; then the
-// fault is repaired, the host sends clear_faults and enables again, and the drive must run the
-// same commands as after power-up as well as it did then: no observer, integrator or check
-// state may survive the clear.
+// The full fault matrix (docs/safety-testing.md, "Fault matrix"): every fault the simulated board
+// can suffer x every law x double and float. The host drives the realistic paper-000 board over CAN
+// (enable, set_speed 60 rad/s every 50 ms) under a 0.5 N m active load, with a 5 N m holding brake.
+// Each case checks the fault's code and detection time, its stop (the PWM off in the detecting tick
+// for STO, later for a controlled stop), the brake line at STO; then the fault is repaired, the
+// host sends clear_faults and enables again, and the drive must run the same commands as after
+// power-up as well as it did then: no observer, integrator or check state may survive the clear.
 #include <gtest/gtest.h>
 
 #include <cmath>
