@@ -157,7 +157,7 @@ class Dsmc {
       const T omega_next = xi1 + load_to_omega_ * in.load_Nm;
       const T omega_ref_after = T(2) * in.omega_ref_next_rad_s - in.omega_ref_rad_s;
       const T target = omega_ref_after + speed_pole_ * (omega_next - in.omega_ref_next_rad_s);
-      const T y_ref = (target - omega_decay_ * omega_next - load_to_omega_ * in.load_Nm) / eta1_;
+      const T y_ref = (target - omega_decay_ * omega_next - load_to_omega_ * in.load_Nm) * per_eta1_;
       // The torque approaches it: y_{k+1} - y* = current_pole (y_k - y*).
       const T y_now = dot_J(current, flux), y_target = std::clamp(y_ref, -y_limit_, y_limit_);
       out.torque_clamped = y_target != y_ref;
@@ -165,7 +165,8 @@ class Dsmc {
     }
     const T lambda11 = lambda1.squaredNorm(), lambda22 = lambda2.squaredNorm();
     const T lambda12 = lambda1.dot(lambda2);
-    const T b1_over_det2 = gain * gain / (det * det);
+    const T per_det = T(1) / det;  // the one division: B^{-1} and b1^2 / det^2 multiply by it
+    const T b1_over_det2 = (gain * per_det) * (gain * per_det);
     // Through the current, the flux's correction is taken at the current pole's pace too:
     // measured from the flux the present current would give (held over the next period), a
     // share current_pole of the correction is left to the next step.
@@ -188,7 +189,7 @@ class Dsmc {
     out.w_beta_tilde = w_beta;
     // v~ = B^{-1} w = (-w_alpha J lambda2 + w_beta J lambda1) / det.
     const auto input = [&](T wa, T wb) {
-      return Vec2<T>((J_times<T>(lambda1) * wb - J_times<T>(lambda2) * wa) / det);
+      return Vec2<T>((J_times<T>(lambda1) * wb - J_times<T>(lambda2) * wa) * per_det);
     };
     out.v_AB_V = input(w_alpha, w_beta);
     // Most ticks the solution lies well inside the disk, and neither channel can saturate:
@@ -272,6 +273,7 @@ class Dsmc {
   bool torque_channel_;
   T current_pole_;
   T y_limit_;
+  T per_eta1_ = T(1) / eta1_;  ///< the torque target multiplies by it (after eta1_)
 };
 
 }  // namespace imd::control

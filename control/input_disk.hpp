@@ -25,7 +25,9 @@ struct InputDisk {
   /// Only +inf means no limit; a NaN radius (a broken input) allows nothing but the centre.
   bool unlimited() const noexcept { return radius_V == std::numeric_limits<T>::infinity(); }
   bool contains(const Vec2<T>& v_V, T tolerance_V = T(0)) const noexcept {
-    return unlimited() || (v_V - center_V).norm() <= radius_V + tolerance_V;
+    // Squared: no square root. A negative or NaN bound contains nothing, as |v - c| <= it.
+    const T bound_V = radius_V + tolerance_V;
+    return unlimited() || (bound_V >= T(0) && (v_V - center_V).squaredNorm() <= bound_V * bound_V);
   }
   /// The nearest point of the disk.
   Vec2<T> clamp(const Vec2<T>& v_V) const noexcept {
@@ -48,7 +50,7 @@ InputDisk<T> inscribed_disk(const InputDisk<T>& first, const InputDisk<T>& secon
   const T s = axis.norm();
   if (s + second.radius_V <= first.radius_V) return second;  // second inside first
   if (s + first.radius_V <= second.radius_V) return first;   // first inside second
-  const Vec2<T> unit = axis / s;                             // s > 0 here
+  const Vec2<T> unit = axis * (T(1) / s);                   // s > 0 here
   if (s >= first.radius_V + second.radius_V) return {first.center_V + unit * first.radius_V, T(0)};
   // The lens meets the axis on [s - r2, r1] (measured from first's centre); the largest disk
   // touching both arcs there has its centre at r1 - rho with rho = (r1 + r2 - s) / 2.

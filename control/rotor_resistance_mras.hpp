@@ -95,7 +95,7 @@ class RotorResistanceMras {
             T omega_mean_rad_s, const Vec2<T>& u_alphabeta_V, bool adapt) noexcept {
     // The current model over [t_{k-1}, t_k], the current taken as its mean over the period.
     const T rho_T = Rr_Ohm_ * inv_Lr_ * period_s_;
-    const T share = rho_T * (T(1) - rho_T * (T(0.5) - rho_T / T(6)));  // 1 - e^{-rho T}
+    const T share = rho_T * (T(1) - rho_T * (T(0.5) - rho_T * (T(1) / T(6))));  // 1 - e^{-rho T}
     flux_AB_Wb_ += share * (Lm_H_ * T(0.5) * (i_AB_A + i_AB_last_A_) - flux_AB_Wb_);
     // Q^ over the period: i.Psi^ and i x Psi^ by the trapezoid, with the period's mean speed.
     const T along_now = i_AB_A.dot(flux_AB_Wb_), across_now = cross(i_AB_A, flux_AB_Wb_);
@@ -119,7 +119,7 @@ class RotorResistanceMras {
     adapting_ = adapt && along_ > T(0) && std::abs(tangent_) >= min_tangent_ &&
                 std::abs(omega_e) >= min_frequency_ && q_adapt_ * omega_e > T(0) &&
                 std::abs(q_adapt_) >= q_floor;
-    const T relative = (q_ref_ - q_adapt_) / q_adapt_;
+    const T relative = adapting_ ? (q_ref_ - q_adapt_) / q_adapt_ : T(0);  // divides if used
     if (adapting_ && std::isfinite(relative)) {
       // The relative step, bounded: one tick moves the estimate by at most gain x 100 %. The
       // steps (gain ~ 1e-4 and less) are summed apart and applied once they reach 1e-4: in

@@ -79,13 +79,6 @@ void Supervisor<T>::select(ControllerKind kind) noexcept {
 }
 
 template <typename T>
-bool Supervisor<T>::modulating() const noexcept {
-  const DriveState s = machine_.state();
-  return s == DriveState::magnetizing || s == DriveState::running || s == DriveState::stopping ||
-         s == DriveState::identifying;
-}
-
-template <typename T>
 void Supervisor<T>::identification_ended(uint64_t k, bool done, uint8_t failure) noexcept {
   if (machine_.state() != DriveState::identifying) return;
   status_.identify_step = done ? 4 : 5;  // kIdentifyStepValues: done, failed

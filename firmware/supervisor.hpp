@@ -100,7 +100,13 @@ class Supervisor {
   }
 
   DriveState state() const noexcept { return machine_.state(); }
-  bool modulating() const noexcept;
+  /// The PWM runs (magnetizing, running, stopping or identifying). Inline: the tick asks
+  /// several times.
+  bool modulating() const noexcept {
+    const DriveState s = machine_.state();
+    return s == DriveState::magnetizing || s == DriveState::running ||
+           s == DriveState::stopping || s == DriveState::identifying;
+  }
   /// The holding brake may be released: the drive runs, or ramps to a controlled stop.
   bool brake_released() const noexcept {
     return machine_.state() == DriveState::running ||

@@ -100,7 +100,6 @@ class DsmcLaw final : public ControlLaw<T> {
     if (!limit_updated_) update_field_weakening(in.e.x_input, in.v_max_V);
     limit_updated_ = false;
     const T flux2_limit = flux2_limit_Wb2_;
-    report.flux_ref_Wb = std::sqrt(std::min(in.next.flux2_Wb2, flux2_limit));
 
     control::DsmcInput<T> d;
     d.flux_r_AB_Wb = in.e.x_input.flux_r_AB_Wb;
@@ -130,10 +129,10 @@ class DsmcLaw final : public ControlLaw<T> {
  private:
   void update_field_weakening(const control::RotorFrameState<T>& x_input, T v_max_V) noexcept {
     const control::Vec2<T>& flux_AB = x_input.flux_r_AB_Wb;
-    const T flux_Wb = std::max(flux_AB.norm(), min_flux_Wb_);
+    const T per_flux = T(1) / std::max(flux_AB.norm(), min_flux_Wb_);  // one division
     const T i_q =
-        (flux_AB.x() * x_input.i_s_AB_A.y() - flux_AB.y() * x_input.i_s_AB_A.x()) / flux_Wb;
-    const T omega_e = p_ * x_input.omega_mech_rad_s + slip_per_A_ * i_q / flux_Wb;
+        (flux_AB.x() * x_input.i_s_AB_A.y() - flux_AB.y() * x_input.i_s_AB_A.x()) * per_flux;
+    const T omega_e = p_ * x_input.omega_mech_rad_s + slip_per_A_ * i_q * per_flux;
     const T v_fw = T(control::kFieldWeakeningVoltageShare) * v_max_V;
     const T flux_limit =
         std::max(control::voltage_limited_flux_Wb(fw_motor_, omega_e, i_q, v_fw),

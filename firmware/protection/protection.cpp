@@ -157,7 +157,7 @@ inline void Protection<T>::check_sensed(const Measurement<T>& m, const Estimate<
       driving ? motor->torque_per_AWb * control::dot_J<T>(e.x.i_s_AB_A, e.x.flux_r_AB_Wb) : T(0);
   if (config_.check_encoder &&
       motor->encoder.failed(m.encoder_delta_counts, e.x.omega_mech_rad_s, torque_Nm,
-                            motor->max_load_Nm(e.x.flux_r_AB_Wb.norm()), driving)) {
+                            motor->max_load_Nm(e.x.flux_r_AB_Wb.squaredNorm()), driving)) {
     trip.add(FaultCode::encoder);
   }
 }

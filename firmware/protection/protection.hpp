@@ -80,12 +80,13 @@ struct MotorChecks {
 
   /// The encoder check's load bound: max_load_share of the torque at the current limit with
   /// this rotor flux (the flux current |psi|/Lm first, the rest torque current), within the
-  /// torque limit. Tick context.
-  T max_load_Nm(T flux_Wb) const noexcept {
-    const T i_d = flux_Wb * per_Lm_H;
-    const T i_q2 = current_limit_A * current_limit_A - i_d * i_d;
-    const T torque =
-        i_q2 > T(0) && flux_Wb > T(0) ? torque_per_AWb * flux_Wb * std::sqrt(i_q2) : T(0);
+  /// torque limit. From the squared flux: |psi| sqrt(i_q^2) is one square root,
+  /// sqrt(|psi|^2 i_q^2). Tick context.
+  T max_load_Nm(T flux2_Wb2) const noexcept {
+    const T i_q2 = current_limit_A * current_limit_A - flux2_Wb2 * (per_Lm_H * per_Lm_H);
+    const T torque = i_q2 > T(0) && flux2_Wb2 > T(0)
+                         ? torque_per_AWb * std::sqrt(flux2_Wb2 * i_q2)
+                         : T(0);
     return max_load_share * std::min(torque, torque_limit_Nm);
   }
 

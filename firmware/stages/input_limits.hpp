@@ -70,7 +70,7 @@ class InputLimits {
       voltage = {-feedback_.compensation_AB_V(x), v_max_V(v_bus_V)};
     }
     if (current_limited_) {
-      current = {-(a21_ * x.flux_r_AB_Wb + a22_ * x.i_s_AB_A) / b2_, current_radius_V_};
+      current = {(a21_ * x.flux_r_AB_Wb + a22_ * x.i_s_AB_A) * minus_per_b2_, current_radius_V_};
     }
     return control::inscribed_disk(voltage, current);
   }
@@ -94,6 +94,7 @@ class InputLimits {
   bool voltage_limited_, current_limited_;
   T modulation_margin_, current_limit_A_, a21_, a22_, b2_;
   T current_radius_V_ = current_limit_A_ / b2_;  ///< the current disk's, once (after b2_)
+  T minus_per_b2_ = T(-1) / b2_;  ///< its centre multiplies by it, not divides (after b2_)
 };
 
 }  // namespace imd::firmware

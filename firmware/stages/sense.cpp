@@ -20,7 +20,8 @@ BoardSensing<T>::BoardSensing(hal::CurrentAdc& adc, hal::Encoder& encoder,
       V_per_code_(T(adc.scale().bus_V_per_code)),
       mid_code_(T(adc.scale().phase_mid_code)),
       max_code_(adc.scale().max_code),
-      counts_per_rev_(static_cast<int32_t>(encoder.counts_per_rev())) {
+      counts_per_rev_(static_cast<int32_t>(encoder.counts_per_rev())),
+      rad_per_count_(T(2 * std::numbers::pi_v<Real> / Real(counts_per_rev_))) {
   if (calibration_ticks_ <= 0) {
     for (T& offset : offset_code_) offset = mid_code_;
     calibrated_ = true;
@@ -95,7 +96,7 @@ void BoardSensing<T>::read_encoder(Measurement<T>& m) noexcept {
   } else if (encoder_position_ >= cpr) {
     encoder_position_ -= cpr;
   }
-  m.theta_encoder_rad = T(2 * std::numbers::pi) * T(encoder_position_) / T(cpr);
+  m.theta_encoder_rad = T(encoder_position_) * rad_per_count_;
 }
 
 template class BoardSensing<float>;

@@ -51,6 +51,7 @@ class BoardSensing final : public Sensing<T> {
   T A_per_code_, V_per_code_, mid_code_;
   uint16_t max_code_;
   int32_t counts_per_rev_;
+  T rad_per_count_;  ///< 2 pi / counts_per_rev_: the angle multiplies, never divides
 
   bool calibrated_ = false;
   bool was_calibrating_ = false;

@@ -89,5 +89,33 @@ TEST(InputDisk, NanRadiusAllowsOnlyTheCentre) {
   EXPECT_FALSE(broken.contains({300.0, 0.0}));
 }
 
+TEST(InputDisk, ContainsComparesTheSquaredDistanceAsTheDistance) {
+  // contains() compares |v - c|^2 with (r + tolerance)^2: the same answer as |v - c| <= r +
+  // tolerance for every point off the circle by more than the rounding of the two sides (a few
+  // ulp of r, here ~1e-13 V on radii up to 400 V), in float and double.
+  const InputDisk<double> disk{{3.0, -2.0}, 250.0};
+  const InputDisk<float> disk_f{{3.0f, -2.0f}, 250.0f};
+  int checked = 0;
+  for (int i = 0; i < 2000; ++i) {
+    const double angle = 0.0031 * i, reach = 180.0 + 0.05 * i;  // through the edge at 250 V
+    const Vec2<double> v = disk.center_V + reach * Vec2<double>(std::cos(angle), std::sin(angle));
+    for (const double tolerance : {0.0, -0.25, 1.0}) {
+      const double bound = disk.radius_V + tolerance;
+      if (std::abs((v - disk.center_V).norm() - bound) < 1e-9) continue;
+      EXPECT_EQ(disk.contains(v, tolerance), (v - disk.center_V).norm() <= bound) << i;
+      const Vec2<float> vf = v.cast<float>();
+      if (std::abs((vf - disk_f.center_V).norm() - float(bound)) < 1e-3f) continue;  // float ulp
+      EXPECT_EQ(disk_f.contains(vf, float(tolerance)), (vf - disk_f.center_V).norm() <= bound);
+      ++checked;
+    }
+  }
+  EXPECT_GT(checked, 5000);
+  // A negative bound contains nothing, not even the centre; a zero radius only the centre.
+  EXPECT_FALSE(disk.contains(disk.center_V, -300.0));
+  const InputDisk<double> point{{1.0, 1.0}, 0.0};
+  EXPECT_TRUE(point.contains({1.0, 1.0}));
+  EXPECT_FALSE(point.contains({1.0, 1.0 + 1e-9}));
+}
+
 }  // namespace
 }  // namespace imd::control
