@@ -157,7 +157,8 @@ class Dsmc {
       const T omega_next = xi1 + load_to_omega_ * in.load_Nm;
       const T omega_ref_after = T(2) * in.omega_ref_next_rad_s - in.omega_ref_rad_s;
       const T target = omega_ref_after + speed_pole_ * (omega_next - in.omega_ref_next_rad_s);
-      const T y_ref = (target - omega_decay_ * omega_next - load_to_omega_ * in.load_Nm) * per_eta1_;
+      const T y_ref =
+          (target - omega_decay_ * omega_next - load_to_omega_ * in.load_Nm) * per_eta1_;
       // The torque approaches it: y_{k+1} - y* = current_pole (y_k - y*).
       const T y_now = dot_J(current, flux), y_target = std::clamp(y_ref, -y_limit_, y_limit_);
       out.torque_clamped = y_target != y_ref;

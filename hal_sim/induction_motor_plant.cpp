@@ -40,7 +40,11 @@ Vec2 phase_axis(int phase) noexcept {
 
 InductionMotorPlant::InductionMotorPlant(const control::MotorParameters& motor,
                                          const PlantConfig& config)
-    : motor_(motor), k_(control::derive_voltage_fed<double>(motor)), config_(config) {
+    : motor_(motor),
+      k_(control::derive_voltage_fed<double>(motor)),
+      per_sigma_H_(1.0 / k_.sigma_H),
+      per_J_kgm2_(1.0 / double(motor.J_kgm2)),
+      config_(config) {
   assert(config.period_s > 0.0 && config.rk4_substeps >= 1);
 }
 
@@ -91,10 +95,10 @@ StateVector InductionMotorPlant::voltage_fed_derivative(const StateVector& x, co
   dx.segment<2>(0) =
       -k_.alpha_per_s * flux + p_omega * j_flux + k_.alpha_per_s * motor_.Lm_H * current;
   dx.segment<2>(2) = k_.alpha_per_s * k_.beta_per_H * flux - p_omega * k_.beta_per_H * j_flux -
-                     k_.gamma_per_s * current + u / k_.sigma_H;
+                     k_.gamma_per_s * current + u * per_sigma_H_;
   // Floating terminals cancel dI/dt along the open phases' axes.
   if (open_phases_ != 0) dx.segment<2>(2) = constrained(dx.segment<2>(2));
-  dx(4) = (torque + shaft_torque_Nm(omega, load_Nm)) / motor_.J_kgm2;
+  dx(4) = (torque + shaft_torque_Nm(omega, load_Nm)) * per_J_kgm2_;
   dx(5) = omega;
   return dx;
 }
@@ -224,7 +228,7 @@ void InductionMotorPlant::step_current_fed(const Vec2& i_s_AB_A, double load_Nm)
     dx.segment<2>(0) = -k_.alpha_per_s * flux + p * x(4) * control::J_times(flux) +
                        k_.alpha_per_s * motor_.Lm_H * current;
     dx.segment<2>(2).setZero();
-    dx(4) = (torque + shaft_torque_Nm(x(4), load_Nm)) / motor_.J_kgm2;
+    dx(4) = (torque + shaft_torque_Nm(x(4), load_Nm)) * per_J_kgm2_;
     dx(5) = x(4);
     return dx;
   };

@@ -158,6 +158,9 @@ class InductionMotorPlant {
 
   control::MotorParameters motor_;
   control::VoltageFedConstantsIn<double> k_;  ///< in double whatever the designs' arithmetic
+  // 1/sigma and 1/J: the right-hand side, evaluated up to 14 times a period, multiplies by
+  // them (neither depends on the resistances, which set_resistances changes).
+  double per_sigma_H_, per_J_kgm2_;
   PlantConfig config_;
   PlantState state_;
   double time_s_ = 0.0;

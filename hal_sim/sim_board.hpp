@@ -15,6 +15,7 @@
 /// No heap, no exceptions: the board also builds for the MCU of a processor-in-the-loop run.
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 
 #include "control/motor_parameters.hpp"
 #include "hal_sim/fault_injection.hpp"
@@ -92,9 +93,20 @@ class SimBoard {
   const InductionMotorPlant& plant() const noexcept { return plant_; }
   const SimBoardConfig& config() const noexcept { return config_; }
 
-  void set_load_profile(const LoadProfile& profile) noexcept { load_ = profile; }
-  /// Load torque over the current period (held, hypothesis H1).
-  double load_Nm() const noexcept { return load_.at(plant_.time_s()); }
+  void set_load_profile(const LoadProfile& profile) noexcept {
+    load_ = profile;
+    load_time_s_ = std::numeric_limits<double>::quiet_NaN();  // evaluate it anew
+  }
+  /// Load torque over the current period (held, hypothesis H1). Kept for the plant's time: a
+  /// lock-step period asks for it before the tick and end_period() again (the same value).
+  double load_Nm() const noexcept {
+    const double t_s = plant_.time_s();
+    if (!(t_s == load_time_s_)) {
+      load_time_s_ = t_s;
+      load_at_time_Nm_ = load_.at(t_s);
+    }
+    return load_at_time_Nm_;
+  }
   /// Stator voltage the plant saw over the last period (alpha-beta); for the analog device, the
   /// value at the start of the period.
   /// With an open phase this is the inverter's output; the plant's terminal voltage differs
@@ -142,6 +154,8 @@ class SimBoard {
   double Rs0_Ohm_, Rr0_Ohm_;  ///< the plant's resistances at t = 0
   AdcModel adc_model_;
   LoadProfile load_;
+  mutable double load_time_s_ = std::numeric_limits<double>::quiet_NaN();  ///< kept for it
+  mutable double load_at_time_Nm_ = 0.0;  ///< load_ at load_time_s_
   SimPwm pwm_;
   SimEncoder encoder_;
   SimAdc adc_;

@@ -21,7 +21,7 @@ BoardSensing<T>::BoardSensing(hal::CurrentAdc& adc, hal::Encoder& encoder,
       mid_code_(T(adc.scale().phase_mid_code)),
       max_code_(adc.scale().max_code),
       counts_per_rev_(static_cast<int32_t>(encoder.counts_per_rev())),
-      rad_per_count_(T(2 * std::numbers::pi_v<Real> / Real(counts_per_rev_))) {
+      rad_per_count_(T(2) * std::numbers::pi_v<T> / T(counts_per_rev_)) {
   if (calibration_ticks_ <= 0) {
     for (T& offset : offset_code_) offset = mid_code_;
     calibrated_ = true;
