@@ -16,8 +16,14 @@
 namespace {
 
 std::string fast(double x) {
+  // The contract is 24 characters of room: the fixed-length copies inside must stay in it.
   char text[40];
-  return std::string(text, imd::tools::format_g10(x, text));
+  std::memset(text, '#', sizeof text);
+  char* end = imd::tools::format_g10(x, text);
+  for (std::size_t i = 24; i < sizeof text; ++i) {
+    if (text[i] != '#') ADD_FAILURE() << "wrote past 24 characters for " << x;
+  }
+  return std::string(text, std::size_t(end - text));
 }
 
 TEST(CsvNumber, SameTextAsFmt) {
