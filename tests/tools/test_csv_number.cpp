@@ -16,7 +16,7 @@
 namespace {
 
 std::string fast(double x) {
-  // The contract is 24 characters of room: the fixed-length copies inside must stay in it.
+  // The contract gives format_g10 24 characters of room: nothing may be written past them.
   char text[40];
   std::memset(text, '#', sizeof text);
   char* end = imd::tools::format_g10(x, text);
