@@ -52,8 +52,7 @@ Drive<T>::Drive(const std::optional<MotorRecord>& record, const DriveConfig& con
   protection_.set_clock(clock_Hz_);
   hw_.pwm.disable();
   supervisor_.status().reset_cause = static_cast<uint8_t>(peripherals.reset_cause);
-  // A fitted brake holds from power-up (its line is not driven): the first heartbeat, published
-  // before the end of the first tick sets the flag, must say so.
+  // A fitted brake holds from power-up (its line not driven): the first heartbeat must say so.
   supervisor_.status().brake_engaged = config.brake_output_line >= 0;
 }
 
@@ -93,6 +92,7 @@ void Drive<T>::on_tick() noexcept {
   react(k, e, out, trip, overrun, law_voltage, model);
   clock.lap(Stage::protect);
   after_write(m, e, plan.mode == Mode::controlling && model != nullptr, u_acted_V, model);
+  supervisor_.prepare(k);  // the next tick's references, off the path to its write
   publish(k, m, e, plan, u, out, model);
   end_identification(k);
   if (bank_.apply_wanted()) release_model();

@@ -8,8 +8,8 @@
 /// limits, SVPWM -> Modulation; actuate: the PWM write (latched for the next period); protect:
 /// every trip decision -> Trip, latched, and the PWM off before the written duties act; publish:
 /// the tick record and CAN telemetry. What the PWM write does not wait for runs after it: the
-/// trip decisions, the observers advanced over the next period and the rotor-resistance
-/// tracker's step.
+/// trip decisions, the observers advanced over the next period, the rotor-resistance
+/// tracker's step and the next tick's references (Supervisor::prepare).
 /// Each stage is timed. T is the control arithmetic: float on the MCU, double on the host.
 #include <atomic>
 #include <cstdint>

@@ -23,7 +23,8 @@ class ReferenceSource {
   ~ReferenceSource() = default;
 
  public:
-  /// The reference for tick k. Tick context.
+  /// The reference for tick k. Tick context. The same k gives the same reference: the
+  /// supervisor reads the next tick's after this tick's PWM write (Supervisor::prepare).
   virtual Reference<T> at_tick(uint64_t k) const noexcept = 0;
 };
 

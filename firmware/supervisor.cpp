@@ -57,6 +57,7 @@ Supervisor<T>::Supervisor(const DriveConfig& config, const SupervisorWiring& wir
 template <typename T>
 void Supervisor<T>::attach(LawRegistry<T>* laws, const Magnetizer<T>* magnetizer,
                            uint64_t k) noexcept {
+  ++generation_;
   laws_ = laws;
   magnetizer_ = magnetizer;
   if (laws_ == nullptr) return;
@@ -173,28 +174,55 @@ inline void Supervisor<T>::references(uint64_t k, const Estimate<T>& e, TickPlan
   // reference, so that the reaching law acts on the real error from the first running tick.
   // Stopping ramps the speed to zero at the stop deceleration.
   p.stopping = machine_.state() == DriveState::stopping;
-  const bool stopping = p.stopping;
+  if (prepared_.k == k && prepared_.generation == generation_ &&
+      machine_.state() == DriveState::running && ramp_.value() == prepared_.ramp_from) {
+    p.now = prepared_.now;  // read ahead by prepare(k - 1), after the last write
+    p.next = prepared_.next;
+    ramp_.reset(prepared_.ramp_k1);
+    return;
+  }
+  if (machine_.state() == DriveState::magnetizing) {
+    ramp_.reset(ramp_.limited()
+                    ? e.x.omega_mech_rad_s
+                    : (p.stopping ? T(0) : references_.at_tick(k).omega_mech_rad_s));
+  }
+  T ramp_k1;
+  shaped(k, p.stopping, p.now, p.next, ramp_k1);
+  ramp_.reset(ramp_k1);
+}
+
+template <typename T>
+inline void Supervisor<T>::shaped(uint64_t k, bool stopping, Reference<T>& now,
+                                  Reference<T>& next, T& ramp_k1) const noexcept {
   const uint64_t latency = predicts_latency_ ? 1 : 0;
   // Each tick's reference is read once: k + 1 and k + 2 serve both the ramp and the law.
   const Reference<T> at_k1 = references_.at_tick(k + 1);
   const Reference<T> at_k2 = references_.at_tick(k + 2);
   const T target_k1 = stopping ? T(0) : at_k1.omega_mech_rad_s;
   const T target_k2 = stopping ? T(0) : at_k2.omega_mech_rad_s;
-  if (machine_.state() == DriveState::magnetizing) {
-    ramp_.reset(ramp_.limited() ? e.x.omega_mech_rad_s
-                                : (stopping ? T(0) : references_.at_tick(k).omega_mech_rad_s));
-  }
-  const T ramp_k1 = ramp_.next(ramp_.value(), target_k1);
-  p.now = latency ? at_k1 : references_.at_tick(k);
-  p.next = latency ? at_k2 : at_k1;
-  p.now.omega_mech_rad_s = latency ? ramp_k1 : ramp_.value();
-  p.next.omega_mech_rad_s = latency ? ramp_.next(ramp_k1, target_k2) : ramp_k1;
-  if (stopping) p.now.torque_Nm = p.next.torque_Nm = T(0);
-  ramp_.reset(ramp_k1);
+  ramp_k1 = ramp_.next(ramp_.value(), target_k1);
+  now = latency ? at_k1 : references_.at_tick(k);
+  next = latency ? at_k2 : at_k1;
+  now.omega_mech_rad_s = latency ? ramp_k1 : ramp_.value();
+  next.omega_mech_rad_s = latency ? ramp_.next(ramp_k1, target_k2) : ramp_k1;
+  if (stopping) now.torque_Nm = next.torque_Nm = T(0);
+}
+
+template <typename T>
+void Supervisor<T>::prepare(uint64_t k) noexcept {
+  prepared_.k = Prepared::kNotPrepared;
+  // Running: plan(k + 1) neither resets the ramp nor stops (a stop begins with a command or a
+  // fault, each of which bumps the generation).
+  if (machine_.state() != DriveState::running) return;
+  shaped(k + 1, false, prepared_.now, prepared_.next, prepared_.ramp_k1);
+  prepared_.ramp_from = ramp_.value();
+  prepared_.generation = generation_;
+  prepared_.k = k + 1;
 }
 
 template <typename T>
 bool Supervisor<T>::latch(const Trip& trip, uint64_t k, const StopContext<T>& motion) noexcept {
+  ++generation_;  // the commanded speed and the ramp's limit change below
   commanded_.set_speed(T(0));  // after clear and enable, the host sends a new speed
   status_.fault_bits = static_cast<uint16_t>(status_.fault_bits | trip.bits);
   if (machine_.state() == DriveState::fault) return true;  // the first fault is kept

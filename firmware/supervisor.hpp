@@ -83,6 +83,11 @@ class Supervisor {
   /// What the checks need of tick k's plan p, after the PWM write (off the latency from sense
   /// to write; nothing between the plan and the checks changes the state).
   SupervisedState supervised(uint64_t k, const TickPlan<T>& p) const noexcept;
+  /// After tick k's PWM write and trip decisions: the references tick k + 1 takes if the drive
+  /// runs on, read ahead off the path to the next write. plan(k + 1) takes them unless what
+  /// they depend on changed meanwhile (a command, a fault, a transition, the ramp), and then
+  /// computes them itself: the same values either way.
+  void prepare(uint64_t k) noexcept;
   /// Latches the faults the protect stage found (the first one keeps its code and time) and
   /// starts their stop (firmware/protection/stop_category.hpp). True: STO, the caller turns the
   /// PWM off now; false: a controlled stop (SS1 or DC braking) runs, or continues, first.
@@ -124,6 +129,9 @@ class Supervisor {
 
  private:
   [[gnu::always_inline]] void references(uint64_t k, const Estimate<T>& e, TickPlan<T>& p) noexcept;
+  /// Tick k's references through the ramp as it stands; `ramp_k1` is where the ramp goes.
+  [[gnu::always_inline]] void shaped(uint64_t k, bool stopping, Reference<T>& now,
+                                     Reference<T>& next, T& ramp_k1) const noexcept;
   // Commands (supervisor_commands.cpp).
   void receive_commands(uint64_t k, TickPlan<T>& p) noexcept;
   protocol::CommandResult apply(const protocol::Command& command, uint64_t k,
@@ -169,6 +177,18 @@ class Supervisor {
   bool record_complete_, record_saved_;  ///< as the last parameter answer said
   T v_bus_V_ = T(0);                     ///< measured this tick (the commissioning's plan)
   bool enable_input_ = true;  ///< read at the start of the stage
+  /// Bumped by whatever changes the references or the ramp's limit: a command applied, an
+  /// enable, a fault latched, a model attached.
+  uint32_t generation_ = 0;
+  /// The references prepare() read ahead for tick `k` (kNotPrepared: none).
+  struct Prepared {
+    static constexpr uint64_t kNotPrepared = UINT64_MAX;
+    uint64_t k = kNotPrepared;
+    uint32_t generation = 0;
+    T ramp_from = T(0);  ///< the ramp's value they were computed from
+    T ramp_k1 = T(0);
+    Reference<T> now, next;
+  } prepared_;
   uint64_t magnetizing_start_tick_ = 0, last_command_tick_ = 0, stop_start_tick_ = 0;
 };
 

@@ -29,6 +29,7 @@ void Supervisor<T>::receive_commands(uint64_t k, TickPlan<T>& p) noexcept {
 
 template <typename T>
 void Supervisor<T>::enable(uint64_t k, TickPlan<T>& p) noexcept {
+  ++generation_;  // the ramp's limit
   if (!machine_.go(DriveState::magnetizing, TransitionReason::enable, k)) return;
   magnetizing_start_tick_ = k;
   last_command_tick_ = k;
@@ -59,6 +60,7 @@ protocol::CommandResult Supervisor<T>::apply(const protocol::Command& c, uint64_
                                              TickPlan<T>& p) noexcept {
   using protocol::CommandKind;
   using protocol::CommandResult;
+  ++generation_;  // any command may change the references, the ramp or the state
   const DriveState s = machine_.state();
   switch (c.kind) {
     case CommandKind::emergency_stop: {

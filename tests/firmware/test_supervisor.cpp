@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <utility>
 
 #include "fakes.hpp"
 #include "firmware/protocol/commands.hpp"
@@ -19,6 +20,17 @@ using Vec2 = control::Vec2<double>;
 /// 50 rad/s and 0.2 Wb^2 at every tick.
 struct Constant final : ReferenceSource<double> {
   Reference<double> at_tick(uint64_t) const noexcept override { return {50.0, 0.2, 0.0, 1.0}; }
+};
+
+/// A reference that differs at every tick (a sine, the flux stepping every 50 ticks), counting
+/// how often it is read.
+struct Varying final : ReferenceSource<double> {
+  Reference<double> at_tick(uint64_t k) const noexcept override {
+    ++reads;
+    return {30.0 + 20.0 * std::sin(double(k) / 100.0), 0.2 + 0.01 * double((k / 50) % 3), 0.0,
+            1.0};
+  }
+  mutable int reads = 0;
 };
 
 struct Bench {
@@ -43,12 +55,13 @@ struct Bench {
     c.commands_over_can = over_can;
     return c;
   }
-  explicit Bench(bool over_can = false)
+  explicit Bench(bool over_can = false, const ReferenceSource<double>* source = nullptr)
       : config(make_config(over_can)),
         coefficients(control::discretize_voltage_fed(test::paper_motor(), 1e-4)),
         laws(LawContext{test::paper_motor(), config, coefficients}),
         magnetizer(test::paper_motor(), coefficients, config),
-        supervisor(config, {&can, &gpio, telemetry}, &references, &laws, &magnetizer, true, true) {
+        supervisor(config, {&can, &gpio, telemetry}, source != nullptr ? source : &references,
+                   &laws, &magnetizer, true, true) {
     m.valid = true;
     e.valid = true;
   }
@@ -158,6 +171,74 @@ TEST(Supervisor, TheSetFluxCommandSetsTheSelectedLawsFlux) {
   b.send({CommandKind::set_flux, 0.3f});
   const TickPlan<double> p = b.supervisor.plan(1, b.m, b.e);  // idle: this tick's reference
   EXPECT_NEAR(p.next.flux2_Wb2, 0.3, 1e-7);
+}
+
+/// The same references, bit for bit, from a plan that takes what prepare() read ahead and
+/// from one that reads them itself.
+void expect_same_plan(const TickPlan<double>& a, const TickPlan<double>& b, uint64_t k) {
+  ASSERT_EQ(a.mode, b.mode) << k;
+  ASSERT_EQ(a.stopping, b.stopping) << k;
+  for (const auto& [x, y] : {std::pair{a.now, b.now}, std::pair{a.next, b.next}}) {
+    ASSERT_EQ(x.omega_mech_rad_s, y.omega_mech_rad_s) << k;
+    ASSERT_EQ(x.flux2_Wb2, y.flux2_Wb2) << k;
+    ASSERT_EQ(x.torque_Nm, y.torque_Nm) << k;
+    ASSERT_EQ(x.stator_flux2_Wb2, y.stator_flux2_Wb2) << k;
+  }
+}
+
+TEST(Supervisor, ReferencesReadAheadAfterTheWriteAreThoseThePlanWouldRead) {
+  Varying ahead_source, direct_source;
+  Bench ahead(false, &ahead_source), direct(false, &direct_source);
+  int taken = 0;
+  for (uint64_t k = 1; k <= 3000; ++k) {
+    for (Bench* b : {&ahead, &direct}) {
+      b->flux(k < 20 ? 0.3 : 0.45);  // magnetizing, then running
+      b->e.x.omega_mech_rad_s = 0.01 * double(k);
+    }
+    const int reads = ahead_source.reads;
+    const TickPlan<double> a = ahead.supervisor.plan(k, ahead.m, ahead.e);
+    const TickPlan<double> d = direct.supervisor.plan(k, direct.m, direct.e);
+    expect_same_plan(a, d, k);
+    if (ahead.supervisor.state() == DriveState::running && ahead_source.reads == reads) ++taken;
+    ahead.supervisor.prepare(k);  // after the write
+  }
+  // Every running tick after the first took the references read ahead (the first was planned
+  // while magnetizing, when the ramp restarts at the estimate).
+  EXPECT_EQ(ahead.supervisor.state(), DriveState::running);
+  EXPECT_GT(taken, 2900);
+}
+
+TEST(Supervisor, ACommandOrAFaultAfterTheReadAheadIsNotMissed) {
+  Bench ahead(true), direct(true);
+  uint64_t k = 1;
+  const auto tick = [&](std::initializer_list<Command> commands) {
+    for (Bench* b : {&ahead, &direct}) {
+      for (const Command& c : commands) b->send(c);
+    }
+    const TickPlan<double> a = ahead.supervisor.plan(k, ahead.m, ahead.e);
+    const TickPlan<double> d = direct.supervisor.plan(k, direct.m, direct.e);
+    expect_same_plan(a, d, k);
+    ahead.supervisor.prepare(k);
+    ++k;
+    return a;
+  };
+  tick({{CommandKind::enable}});
+  for (Bench* b : {&ahead, &direct}) b->flux(0.45);
+  tick({{CommandKind::set_speed, 20.0f}});
+  for (int n = 0; n < 50; ++n) tick({});
+  ASSERT_EQ(ahead.supervisor.state(), DriveState::running);
+  // A new speed between the read-ahead and the plan: the ramp turns towards it at once.
+  const double before = tick({}).next.omega_mech_rad_s;
+  const TickPlan<double> turned = tick({{CommandKind::set_speed, -20.0f}});
+  EXPECT_LT(turned.next.omega_mech_rad_s, before);
+  for (int n = 0; n < 20; ++n) tick({});
+  // A fault latched after the read-ahead: its stop's ramp from the next plan on.
+  Trip trip;
+  trip.add(FaultCode::phase_loss, 0);
+  for (Bench* b : {&ahead, &direct}) b->supervisor.latch(trip, k - 1);
+  for (int n = 0; n < 20; ++n) tick({});
+  EXPECT_EQ(ahead.supervisor.state(), direct.supervisor.state());
+  EXPECT_NE(ahead.supervisor.state(), DriveState::running);
 }
 
 }  // namespace
