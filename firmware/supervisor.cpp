@@ -192,7 +192,7 @@ inline void Supervisor<T>::references(uint64_t k, const Estimate<T>& e, TickPlan
 }
 
 template <typename T>
-inline void Supervisor<T>::shaped(uint64_t k, bool stopping, Reference<T>& now,
+void Supervisor<T>::shaped(uint64_t k, bool stopping, Reference<T>& now,
                                   Reference<T>& next, T& ramp_k1) const noexcept {
   const uint64_t latency = predicts_latency_ ? 1 : 0;
   // Each tick's reference is read once: k + 1 and k + 2 serve both the ramp and the law.

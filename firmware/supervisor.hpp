@@ -129,9 +129,10 @@ class Supervisor {
 
  private:
   [[gnu::always_inline]] void references(uint64_t k, const Estimate<T>& e, TickPlan<T>& p) noexcept;
-  /// Tick k's references through the ramp as it stands; `ramp_k1` is where the ramp goes.
-  [[gnu::always_inline]] void shaped(uint64_t k, bool stopping, Reference<T>& now,
-                                     Reference<T>& next, T& ramp_k1) const noexcept;
+  /// Tick k's references through the ramp as it stands; `ramp_k1` is where the ramp goes. Out
+  /// of line: plan and prepare share one copy (a read ahead taken calls it not at all).
+  [[gnu::noinline]] void shaped(uint64_t k, bool stopping, Reference<T>& now, Reference<T>& next,
+                                T& ramp_k1) const noexcept;
   // Commands (supervisor_commands.cpp).
   void receive_commands(uint64_t k, TickPlan<T>& p) noexcept;
   protocol::CommandResult apply(const protocol::Command& command, uint64_t k,
