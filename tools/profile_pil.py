@@ -140,6 +140,34 @@ def source_lines(elf, per_address):
     return per_line
 
 
+# What an instruction does, by its mnemonic (Thumb-2 and the FPv4 single-precision FPU), in
+# the order tried: the arithmetic the tick needs, and what moves its values and chooses its path.
+_CLASSES = [
+    ("FP arithmetic",
+     re.compile(r"^v(add|sub|n?mul|n?ml[as]|fn?m[as]|div|sqrt|neg|abs|cvt|cmpe?)(\.|$)")),
+    ("FP load, store, move", re.compile(r"^v(ldr|str|ldm\w*|stm\w*|push|pop|mov|mrs|msr)")),
+    ("load, store", re.compile(r"^(ldr|str|ldm|stm)[a-z]*(\.[nw])?$|^(push|pop)(\.w)?$")),
+    ("branch", re.compile(r"^(b|bl|blx|bx)(eq|ne|cs|cc|hs|lo|mi|pl|vs|vc|hi|ls|ge|lt|gt|le|al)?"
+                          r"(\.[nw])?$|^(cbn?z|tb[bh]|it[te]*)$")),
+    ("compare", re.compile(r"^(cmp|cmn|tst|teq)(\.[nw])?$")),
+    ("integer", re.compile(r".")),
+]
+
+
+def instruction_classes(elf, per_address):
+    """Executions per instruction class (_CLASSES) of the addresses counted."""
+    listing = subprocess.run(["arm-none-eabi-objdump", "-d", "--no-show-raw-insn", elf],
+                             capture_output=True, text=True, check=True).stdout
+    mnemonic = {}
+    for m in re.finditer(r"^\s*([0-9a-f]+):\s+([a-z][a-z0-9.]*)", listing, re.M):
+        mnemonic[int(m.group(1), 16)] = m.group(2)
+    per_class = collections.Counter()
+    for pc, n in per_address.items():
+        name = mnemonic.get(pc, "?")
+        per_class[next(c for c, rule in _CLASSES if rule.match(name))] += n
+    return per_class
+
+
 def demangle(names):
     try:
         out = subprocess.run(["c++filt"], input="\n".join(names), capture_output=True,
@@ -160,6 +188,9 @@ def main():
     p.add_argument("--lines", default="", help="a regex of (mangled) function names whose "
                    "instructions are also listed by source line")
     p.add_argument("--all", action="store_true", help="print every function and line")
+    p.add_argument("--classes", action="store_true", help="also count the --lines functions' "
+                   "instructions by kind: FP arithmetic, FP and integer loads, stores and "
+                   "moves, branches, compares, other integer")
     a = p.parse_args()
     if a.to_ms <= a.from_ms:
         sys.exit("profile_pil: --to-ms must be after --from-ms")
@@ -180,9 +211,17 @@ def main():
     if lines_of:
         per_pc = {pc: late_pc[pc] - early_pc.get(pc, 0) for pc in late_pc}
         per_line = source_lines(a.elf, {pc: n for pc, n in per_pc.items() if n > 0})
-        print(f"\ninstructions per tick by source line, functions matching {a.lines!r}")
+        print(f"\ninstructions per tick by source line, functions matching {a.lines!r} "
+              f"({sum(per_line.values()) / ticks:.1f} in all)")
         for where, n in per_line.most_common(None if a.all else a.top):
             print(f"{n / ticks:9.1f}  {where}")
+        if a.classes:
+            per_class = instruction_classes(a.elf, {pc: n for pc, n in per_pc.items() if n > 0})
+            total = sum(per_class.values())
+            print(f"\ninstructions per tick by kind, functions matching {a.lines!r}")
+            for kind, _ in _CLASSES:
+                print(f"{per_class[kind] / ticks:9.1f}  {100 * per_class[kind] / total:5.1f} %"
+                      f"  {kind}")
 
 
 if __name__ == "__main__":

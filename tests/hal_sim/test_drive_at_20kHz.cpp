@@ -2,7 +2,7 @@
 // shipped scenarios do not use at least as well as at 10 kHz, and what depends on the period
 // follows it: the designs placed in continuous time keep their poles' time constants, the
 // windows and rates given as times double in ticks, and the protections answer in the same
-// time (docs/performance-tick.md, "20 kHz").
+// time (docs/performance-20kHz.md).
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -55,7 +55,7 @@ Scenario at_period(const std::string& file, double period_s, std::vector<std::st
 /// reference before its ramp, so steps would measure the ramp. The rotor-resistance tracker is
 /// off: on the 0.75 kW motor its estimate wanders further from the true Rr at 20 kHz than at
 /// 10 kHz (up to 5 % against 1.6 % over nearby profiles, with or without ADC noise, encoder
-/// quantization and dead time), and the flux with it (docs/performance-tick.md, "20 kHz"); this
+/// quantization and dead time), and the flux with it (docs/performance-20kHz.md); this
 /// test is about the loops and the designs.
 Scenario offset_sine(const MotorCase& m, double period_s, unsigned seed) {
   Scenario s = at_period(m.file, period_s,

@@ -13,6 +13,9 @@ What it checks, and why the bounds hold:
 - The total is at least ten times the tick's function: the plant integrates in soft double,
   tens of thousands of instructions a tick, and it must be in the list.
 - The source lines name the firmware's files: the image has its debug information.
+- The instructions by kind (--classes) add up to those by source line, each kind printed to a
+  tenth (six of them: 0.3 at most apart), and some are FP arithmetic (the bus voltage is scaled
+  at every tick): every counted address was found in the disassembly and classified.
 
 Usage: profile_pil_test.py --elf drive_pil_mps2_an386.elf
 """
@@ -27,13 +30,15 @@ TOOL = os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', '..', 'too
 HEAD_RE = re.compile(r'^instructions per tick, .* \((\d+) ticks\); total (\d+)$', re.M)
 TICK_RE = re.compile(r'^\s*([\d.]+)\s+imd::firmware::Drive<float>::on_tick\(\)$', re.M)
 LINE_RE = re.compile(r'^\s*[\d.]+\s+firmware/\S+\.(cpp|hpp):\d+$', re.M)
+LINES_TOTAL_RE = re.compile(r'^instructions per tick by source line, .* \(([\d.]+) in all\)$', re.M)
+KIND_RE = re.compile(r'^\s*([\d.]+)\s+[\d.]+ %  (.+)$', re.M)
 
 
 def profile(elf, from_ms, to_ms, failures):
     """(ticks, total, on_tick) of one window, or None."""
     done = subprocess.run([sys.executable, TOOL, elf, '--from-ms', str(from_ms), '--to-ms',
-                           str(to_ms), '--lines', 'imd8firmware'], capture_output=True,
-                          text=True, timeout=600)
+                           str(to_ms), '--lines', 'imd8firmware', '--classes'],
+                          capture_output=True, text=True, timeout=600)
     sys.stdout.write(done.stdout)
     sys.stderr.write(done.stderr)
     head, tick = HEAD_RE.search(done.stdout), TICK_RE.search(done.stdout)
@@ -43,6 +48,13 @@ def profile(elf, from_ms, to_ms, failures):
         return None
     if not LINE_RE.search(done.stdout):
         failures.append(f'{from_ms}..{to_ms} ms: no firmware source line (debug information?)')
+    lines_total, kinds = LINES_TOTAL_RE.search(done.stdout), dict(
+        (kind, float(n)) for n, kind in KIND_RE.findall(done.stdout))
+    if not lines_total or len(kinds) != 6 or \
+            abs(sum(kinds.values()) - float(lines_total[1])) > 0.3 or \
+            not kinds.get('FP arithmetic', 0) > 0:
+        failures.append(f'{from_ms}..{to_ms} ms: the kinds {kinds} do not add up to the source '
+                        f'lines\' {lines_total[1] if lines_total else "(none)"}')
     return int(head[1]), int(head[2]), float(tick[1])
 
 
