@@ -251,6 +251,13 @@ TEST(SocketcandClient, AsksToBeWokenWhileAFrameIsUnsent) {
   const auto client = SocketcandClient::open("127.0.0.1", server.port, error);
   ASSERT_TRUE(client) << error;
   EXPECT_EQ(client->poll_events(), POLLIN);
+  // A small kernel send buffer: left to autotuning, TCP took about 2.8 MB before it filled, and
+  // draining that took a loaded 2-core machine past kWait (5 s; 1.6 s with four busy loops
+  // beside it, 0.3 s idle). The client's own pending output is what the test is about.
+  const int send_buffer_bytes = 4096;
+  ASSERT_EQ(::setsockopt(client->native_handle(), SOL_SOCKET, SO_SNDBUF, &send_buffer_bytes,
+                         sizeof send_buffer_bytes),
+            0);
   // The server reads nothing: TCP fills, then the client keeps the rest pending.
   int sends = 0;
   while (client->try_send(frame_of(0x021, {1, 2, 3, 4, 5, 6, 7, 8})) && sends < 1'000'000) {
