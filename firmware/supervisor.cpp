@@ -175,10 +175,10 @@ inline void Supervisor<T>::references(uint64_t k, const Estimate<T>& e, TickPlan
   // Stopping ramps the speed to zero at the stop deceleration.
   p.stopping = machine_.state() == DriveState::stopping;
   if (prepared_.k == k && prepared_.generation == generation_ &&
-      machine_.state() == DriveState::running && ramp_.value() == prepared_.ramp_from) {
+      machine_.state() == DriveState::running && ramp_.value() == prepared_.ramp_from_rad_s) {
     p.now = prepared_.now;  // read ahead by prepare(k - 1), after the last write
     p.next = prepared_.next;
-    ramp_.reset(prepared_.ramp_k1);
+    ramp_.reset(prepared_.ramp_k1_rad_s);
     return;
   }
   if (machine_.state() == DriveState::magnetizing) {
@@ -186,25 +186,25 @@ inline void Supervisor<T>::references(uint64_t k, const Estimate<T>& e, TickPlan
                     ? e.x.omega_mech_rad_s
                     : (p.stopping ? T(0) : references_.at_tick(k).omega_mech_rad_s));
   }
-  T ramp_k1;
-  shaped(k, p.stopping, p.now, p.next, ramp_k1);
-  ramp_.reset(ramp_k1);
+  T ramp_k1_rad_s;
+  shaped(k, p.stopping, p.now, p.next, ramp_k1_rad_s);
+  ramp_.reset(ramp_k1_rad_s);
 }
 
 template <typename T>
-void Supervisor<T>::shaped(uint64_t k, bool stopping, Reference<T>& now,
-                                  Reference<T>& next, T& ramp_k1) const noexcept {
+void Supervisor<T>::shaped(uint64_t k, bool stopping, Reference<T>& now, Reference<T>& next,
+                           T& ramp_k1_rad_s) const noexcept {
   const uint64_t latency = predicts_latency_ ? 1 : 0;
   // Each tick's reference is read once: k + 1 and k + 2 serve both the ramp and the law.
   const Reference<T> at_k1 = references_.at_tick(k + 1);
   const Reference<T> at_k2 = references_.at_tick(k + 2);
   const T target_k1 = stopping ? T(0) : at_k1.omega_mech_rad_s;
   const T target_k2 = stopping ? T(0) : at_k2.omega_mech_rad_s;
-  ramp_k1 = ramp_.next(ramp_.value(), target_k1);
+  ramp_k1_rad_s = ramp_.next(ramp_.value(), target_k1);
   now = latency ? at_k1 : references_.at_tick(k);
   next = latency ? at_k2 : at_k1;
-  now.omega_mech_rad_s = latency ? ramp_k1 : ramp_.value();
-  next.omega_mech_rad_s = latency ? ramp_.next(ramp_k1, target_k2) : ramp_k1;
+  now.omega_mech_rad_s = latency ? ramp_k1_rad_s : ramp_.value();
+  next.omega_mech_rad_s = latency ? ramp_.next(ramp_k1_rad_s, target_k2) : ramp_k1_rad_s;
   if (stopping) now.torque_Nm = next.torque_Nm = T(0);
 }
 
@@ -214,8 +214,8 @@ void Supervisor<T>::prepare(uint64_t k) noexcept {
   // Running: plan(k + 1) neither resets the ramp nor stops (a stop begins with a command or a
   // fault, each of which bumps the generation).
   if (machine_.state() != DriveState::running) return;
-  shaped(k + 1, false, prepared_.now, prepared_.next, prepared_.ramp_k1);
-  prepared_.ramp_from = ramp_.value();
+  shaped(k + 1, false, prepared_.now, prepared_.next, prepared_.ramp_k1_rad_s);
+  prepared_.ramp_from_rad_s = ramp_.value();
   prepared_.generation = generation_;
   prepared_.k = k + 1;
 }

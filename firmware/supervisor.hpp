@@ -129,10 +129,10 @@ class Supervisor {
 
  private:
   [[gnu::always_inline]] void references(uint64_t k, const Estimate<T>& e, TickPlan<T>& p) noexcept;
-  /// Tick k's references through the ramp as it stands; `ramp_k1` is where the ramp goes. Out
-  /// of line: plan and prepare share one copy (a read ahead taken calls it not at all).
+  /// Tick k's references through the ramp as it stands; `ramp_k1_rad_s` is where the ramp goes.
+  /// Out of line: plan and prepare share one copy (a read ahead taken calls it not at all).
   [[gnu::noinline]] void shaped(uint64_t k, bool stopping, Reference<T>& now, Reference<T>& next,
-                                T& ramp_k1) const noexcept;
+                                T& ramp_k1_rad_s) const noexcept;
   // Commands (supervisor_commands.cpp).
   void receive_commands(uint64_t k, TickPlan<T>& p) noexcept;
   protocol::CommandResult apply(const protocol::Command& command, uint64_t k,
@@ -178,16 +178,16 @@ class Supervisor {
   bool record_complete_, record_saved_;  ///< as the last parameter answer said
   T v_bus_V_ = T(0);                     ///< measured this tick (the commissioning's plan)
   bool enable_input_ = true;  ///< read at the start of the stage
-  /// Bumped by whatever changes the references or the ramp's limit: a command applied, an
-  /// enable, a fault latched, a model attached.
+  /// Bumped by whatever changes the references or the ramp's limit (a command applied, an
+  /// enable, a fault latched), and by a model attached, which drops a read-ahead to be safe.
   uint32_t generation_ = 0;
   /// The references prepare() read ahead for tick `k` (kNotPrepared: none).
   struct Prepared {
     static constexpr uint64_t kNotPrepared = UINT64_MAX;
     uint64_t k = kNotPrepared;
     uint32_t generation = 0;
-    T ramp_from = T(0);  ///< the ramp's value they were computed from
-    T ramp_k1 = T(0);
+    T ramp_from_rad_s = T(0);  ///< the ramp's value they were computed from
+    T ramp_k1_rad_s = T(0);    ///< the ramp's value they leave
     Reference<T> now, next;
   } prepared_;
   uint64_t magnetizing_start_tick_ = 0, last_command_tick_ = 0, stop_start_tick_ = 0;

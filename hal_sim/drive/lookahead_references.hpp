@@ -3,7 +3,8 @@
 /// would fill it: the tick only reads a ring of precomputed references. The processor-in-the-
 /// loop run fills it between ticks, so that the double-precision profiles (a sine) are not
 /// counted in the tick's cost. The drive asks for at most k + kDepth - 1 at tick k (the DSMC
-/// two ticks ahead, the current-fed law one T0 ahead).
+/// two ticks ahead, three when it reads the next tick's ahead after the write, the current-fed
+/// law one T0 ahead).
 #include <array>
 #include <cstdint>
 

@@ -232,13 +232,17 @@ TEST(Supervisor, ACommandOrAFaultAfterTheReadAheadIsNotMissed) {
   const TickPlan<double> turned = tick({{CommandKind::set_speed, -20.0f}});
   EXPECT_LT(turned.next.omega_mech_rad_s, before);
   for (int n = 0; n < 20; ++n) tick({});
-  // A fault latched after the read-ahead: its stop's ramp from the next plan on.
+  // A fault latched after the read-ahead whose stop is a ramp (SS1): the drive stops on the
+  // stop's ramp from the next plan on, not on the speed read ahead.
   Trip trip;
-  trip.add(FaultCode::phase_loss, 0);
+  trip.add(FaultCode::command_timeout);
   for (Bench* b : {&ahead, &direct}) b->supervisor.latch(trip, k - 1);
+  ASSERT_EQ(ahead.supervisor.state(), DriveState::stopping);
+  ASSERT_EQ(ahead.supervisor.status().stop, StopCategory::ss1);
+  const TickPlan<double> stopping = tick({});
+  EXPECT_TRUE(stopping.stopping);
   for (int n = 0; n < 20; ++n) tick({});
   EXPECT_EQ(ahead.supervisor.state(), direct.supervisor.state());
-  EXPECT_NE(ahead.supervisor.state(), DriveState::running);
 }
 
 }  // namespace

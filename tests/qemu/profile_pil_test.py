@@ -13,8 +13,8 @@ What it checks, and why the bounds hold:
 - The total is at least ten times the tick's function: the plant integrates in soft double,
   tens of thousands of instructions a tick, and it must be in the list.
 - The source lines name the firmware's files: the image has its debug information.
-- The instructions by kind (--classes) add up to those by source line, each kind printed to a
-  tenth (six of them: 0.3 at most apart), and some are FP arithmetic (the bus voltage is scaled
+- The instructions by kind (--classes) add up to those by source line, each of the six kinds and
+  the total printed to a tenth (0.35 at most apart), and some are FP arithmetic (the bus voltage is scaled
   at every tick): every counted address was found in the disassembly and classified.
 
 Usage: profile_pil_test.py --elf drive_pil_mps2_an386.elf
@@ -51,7 +51,7 @@ def profile(elf, from_ms, to_ms, failures):
     lines_total, kinds = LINES_TOTAL_RE.search(done.stdout), dict(
         (kind, float(n)) for n, kind in KIND_RE.findall(done.stdout))
     if not lines_total or len(kinds) != 6 or \
-            abs(sum(kinds.values()) - float(lines_total[1])) > 0.3 or \
+            abs(sum(kinds.values()) - float(lines_total[1])) > 0.35 or \
             not kinds.get('FP arithmetic', 0) > 0:
         failures.append(f'{from_ms}..{to_ms} ms: the kinds {kinds} do not add up to the source '
                         f'lines\' {lines_total[1] if lines_total else "(none)"}')
