@@ -31,8 +31,8 @@ ScenarioProfiles profiles(const Scenario& s);
 /// The scenario's profiles as the reference source of a drive of arithmetic T: evaluated in
 /// double at each tick's time, then rounded to T. The drive asks for a tick several times
 /// (its look-ahead asks for k + 1 and k + 2 at tick k, and k + 3 for the next tick after the
-/// PWM write): the last few ticks' references are
-/// kept, so that each profile (a sine: about 140 instructions) is evaluated once per tick.
+/// PWM write): the last few ticks' references are kept, so that each profile (a sine: about 140
+/// instructions) is evaluated once per tick.
 template <typename T>
 class ScenarioReferences final : public firmware::ReferenceSource<T> {
  public:
