@@ -174,8 +174,9 @@ inline void Supervisor<T>::references(uint64_t k, const Estimate<T>& e, TickPlan
   // reference, so that the reaching law acts on the real error from the first running tick.
   // Stopping ramps the speed to zero at the stop deceleration.
   p.stopping = machine_.state() == DriveState::stopping;
+  // The ramp's value needs no test: only this function moves it.
   if (prepared_.k == k && prepared_.generation == generation_ &&
-      machine_.state() == DriveState::running && ramp_.value() == prepared_.ramp_from_rad_s) {
+      machine_.state() == DriveState::running) {
     p.now = prepared_.now;  // read ahead by prepare(k - 1), after the last write
     p.next = prepared_.next;
     ramp_.reset(prepared_.ramp_k1_rad_s);
@@ -215,7 +216,6 @@ void Supervisor<T>::prepare(uint64_t k) noexcept {
   // fault, each of which bumps the generation).
   if (machine_.state() != DriveState::running) return;
   shaped(k + 1, false, prepared_.now, prepared_.next, prepared_.ramp_k1_rad_s);
-  prepared_.ramp_from_rad_s = ramp_.value();
   prepared_.generation = generation_;
   prepared_.k = k + 1;
 }

@@ -186,8 +186,7 @@ class Supervisor {
     static constexpr uint64_t kNotPrepared = UINT64_MAX;
     uint64_t k = kNotPrepared;
     uint32_t generation = 0;
-    T ramp_from_rad_s = T(0);  ///< the ramp's value they were computed from
-    T ramp_k1_rad_s = T(0);    ///< the ramp's value they leave
+    T ramp_k1_rad_s = T(0);  ///< the ramp's value they leave
     Reference<T> now, next;
   } prepared_;
   uint64_t magnetizing_start_tick_ = 0, last_command_tick_ = 0, stop_start_tick_ = 0;

@@ -22,6 +22,8 @@ import sys
 import tempfile
 import threading
 
+import check_tick_path  # its objdump runner, for --classes
+
 _TRACE = re.compile(rb"^\[[0-9a-f]+/([0-9a-f]+)/[0-9a-f]+/([0-9a-f]+)\] ?(.*)$")
 _CF_COUNT_MASK = 0x1FF  # QEMU's instruction limit of a block in its cflags (0: none)
 _INSN = re.compile(rb"^0x([0-9a-f]+):  ")
@@ -156,8 +158,7 @@ _CLASSES = [
 
 def instruction_classes(elf, per_address):
     """Executions per instruction class (_CLASSES) of the addresses counted."""
-    listing = subprocess.run(["arm-none-eabi-objdump", "-d", "--no-show-raw-insn", elf],
-                             capture_output=True, text=True, check=True).stdout
+    listing = check_tick_path.objdump("arm-none-eabi-objdump", "-d", "--no-show-raw-insn", elf)
     mnemonic = {}
     for m in re.finditer(r"^\s*([0-9a-f]+):\s+([a-z][a-z0-9.]*)", listing, re.M):
         mnemonic[int(m.group(1), 16)] = m.group(2)
