@@ -18,6 +18,7 @@
 #include <cmath>
 #include <limits>
 
+#include "control/atan2.hpp"
 #include "control/field_weakening.hpp"
 #include "control/flux_frame_current_loop.hpp"
 #include "control/frames.hpp"
@@ -74,8 +75,8 @@ class Ifoc {
   /// Starts on a magnetized motor: the rotor flux (rotor frame) and the current flowing.
   void start(const Vec2<T>& flux_r_AB_Wb, const Vec2<T>& i_AB_A) noexcept {
     const T flux = flux_r_AB_Wb.norm();
-    const T angle = flux > min_flux_ ? std::atan2(flux_r_AB_Wb.y(), flux_r_AB_Wb.x())
-                                     : std::atan2(i_AB_A.y(), i_AB_A.x());
+    const T angle = flux > min_flux_ ? atan2_rad(flux_r_AB_Wb.y(), flux_r_AB_Wb.x())
+                                     : atan2_rad(i_AB_A.y(), i_AB_A.x());
     flux_model_.reset(flux, angle);
     const Vec2<T> i_dq = flux_model_.frame().apply_inverse(i_AB_A);
     current_loop_.reset(i_dq);
