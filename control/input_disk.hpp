@@ -41,9 +41,11 @@ struct InputDisk {
 };
 
 /// Largest disk inside the intersection of two disks. If they do not intersect, returns the
-/// point of `first` nearest to `second` (radius 0): `first` is the hard limit.
+/// point of `first` nearest to `second` (radius 0): `first` is the hard limit. Inlined: the
+/// disks it takes and gives then stay in registers (docs/performance-compiler.md).
 template <typename T>
-InputDisk<T> inscribed_disk(const InputDisk<T>& first, const InputDisk<T>& second) noexcept {
+[[gnu::always_inline]] inline InputDisk<T> inscribed_disk(const InputDisk<T>& first,
+                                                           const InputDisk<T>& second) noexcept {
   if (second.unlimited()) return first;
   if (first.unlimited()) return second;
   const Vec2<T> axis = second.center_V - first.center_V;

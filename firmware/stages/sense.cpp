@@ -78,7 +78,7 @@ Calibration BoardSensing<T>::calibrate(const hal::AdcSample& sample, Measurement
 }
 
 template <typename T>
-void BoardSensing<T>::read_encoder(Measurement<T>& m) noexcept {
+inline void BoardSensing<T>::read_encoder(Measurement<T>& m) noexcept {
   // Unwrap the free-running counter by differences, keep one revolution. 32-bit: the MCU
   // divides those in hardware (cpr <= 2^30, |delta| < 2^31 - 2^30).
   const uint32_t count = encoder_.count();

@@ -41,7 +41,7 @@ class BoardSensing final : public Sensing<T> {
 
  private:
   Calibration calibrate(const hal::AdcSample& sample, Measurement<T>& m) noexcept;
-  void read_encoder(Measurement<T>& m) noexcept;
+  [[gnu::always_inline]] inline void read_encoder(Measurement<T>& m) noexcept;  // one caller
 
   hal::CurrentAdc& adc_;
   hal::Encoder& encoder_;
