@@ -11,7 +11,9 @@
 
 namespace imd::control {
 
-inline double atan2_rad(double y, double x) noexcept { return std::atan2(y, x); }
+inline double atan2_rad(double y, double x) noexcept {
+  return std::atan2(y, x);
+}
 
 inline float atan2_rad(float y, float x) noexcept {
   const float ay = std::fabs(y), ax = std::fabs(x);
@@ -24,9 +26,12 @@ inline float atan2_rad(float y, float x) noexcept {
     offset = 0.785398163f;
   }
   const float z = t * t;
-  const float a = offset + ((((8.05374449538e-2f * z - 1.38776856032e-1f) * z +
-                              1.99777106478e-1f) * z - 3.33329491539e-1f) * z * t + t);
-  const float octant = ay > ax ? 1.570796327f - a : a;      // the angle in [0, pi/2]
+  const float a =
+      offset + ((((8.05374449538e-2f * z - 1.38776856032e-1f) * z + 1.99777106478e-1f) * z -
+                 3.33329491539e-1f) *
+                    z * t +
+                t);
+  const float octant = ay > ax ? 1.570796327f - a : a;           // the angle in [0, pi/2]
   const float half = x < 0.0f ? 3.141592654f - octant : octant;  // in [0, pi]
   return y < 0.0f ? -half : half;
 }

@@ -84,7 +84,9 @@ class Ifoc {
     fw_updated_ = false;
   }
 
-  IfocOutput<T> step(const IfocInput<T>& in) noexcept {
+  /// One tick. Inlined into the law's adapter, its one caller: its input and output structures
+  /// then stay in registers (docs/performance-compiler.md).
+  [[gnu::always_inline]] IfocOutput<T> step(const IfocInput<T>& in) noexcept {
     IfocOutput<T> out;
     flux_model_.advance(flux_model_.frame().apply_inverse(in.i_now_AB_A));
     // The frame of the input's period (the latency's ticks after this one).

@@ -45,14 +45,14 @@ struct InputDisk {
 /// disks it takes and gives then stay in registers (docs/performance-compiler.md).
 template <typename T>
 [[gnu::always_inline]] inline InputDisk<T> inscribed_disk(const InputDisk<T>& first,
-                                                           const InputDisk<T>& second) noexcept {
+                                                          const InputDisk<T>& second) noexcept {
   if (second.unlimited()) return first;
   if (first.unlimited()) return second;
   const Vec2<T> axis = second.center_V - first.center_V;
   const T s = axis.norm();
   if (s + second.radius_V <= first.radius_V) return second;  // second inside first
   if (s + first.radius_V <= second.radius_V) return first;   // first inside second
-  const Vec2<T> unit = axis * (T(1) / s);                   // s > 0 here
+  const Vec2<T> unit = axis * (T(1) / s);                    // s > 0 here
   if (s >= first.radius_V + second.radius_V) return {first.center_V + unit * first.radius_V, T(0)};
   // The lens meets the axis on [s - r2, r1] (measured from first's centre); the largest disk
   // touching both arcs there has its centre at r1 - rho with rho = (r1 + r2 - s) / 2.

@@ -108,7 +108,7 @@ set_tests_properties(qemu_profile_pil PROPERTIES LABELS qemu TIMEOUT 900)
 # overrun in virtual time, the metrics within the float noise of the host's 20 kHz run, and the
 # whole tick's share of the 50 us period printed at 170 MHz with 1.5 cycles per instruction
 # (docs/performance-20kHz.md). The target is a quarter of the period, 1 416
-# instructions; the whole tick takes about 2 850 today, so the share is reported, not checked:
+# instructions; the whole tick takes about 2 720 today, so the share is reported, not checked:
 # add --max-tick-share 0.25 once it fits.
 add_test(NAME qemu_pil_mps2_an386_20kHz
          COMMAND /usr/bin/python3 ${CMAKE_CURRENT_SOURCE_DIR}/qemu/pil_test.py

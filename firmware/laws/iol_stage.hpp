@@ -81,10 +81,12 @@ class IolStage {
 
   /// One tick while running. `flux_r_AB_Wb`, `omega` and `i_est_AB_A` are the estimates at
   /// this tick; `ref_next` is the reference for the next T0 boundary; `v_max_V` the stator
-  /// voltage the modulation reaches (+inf without a limit).
-  IolTickResult<T> tick(const control::Vec2<T>& flux_r_AB_Wb, T omega_mech_rad_s,
-                        const Reference<T>& ref_next, T v_max_V,
-                        const control::Vec2<T>& i_est_AB_A) noexcept {
+  /// voltage the modulation reaches (+inf without a limit). Inlined into the law's adapter, its
+  /// one caller (docs/performance-compiler.md).
+  [[gnu::always_inline]] IolTickResult<T> tick(const control::Vec2<T>& flux_r_AB_Wb,
+                                               T omega_mech_rad_s, const Reference<T>& ref_next,
+                                               T v_max_V,
+                                               const control::Vec2<T>& i_est_AB_A) noexcept {
     IolTickResult<T> r;
     // The tick's place in the period, counted and wrapped (no 64-bit modulo in the tick).
     const int phase = phase_;

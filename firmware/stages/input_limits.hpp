@@ -66,7 +66,7 @@ class InputLimits {
   /// The rotor-frame inputs v~ allowed over the period that starts in state x. Inlined into the
   /// law stage, before the write (docs/performance-compiler.md).
   [[gnu::always_inline]] control::InputDisk<T> feasible(const control::RotorFrameState<T>& x,
-                                                         T v_bus_V) const noexcept {
+                                                        T v_bus_V) const noexcept {
     control::InputDisk<T> voltage, current;
     if (voltage_limited_) {
       voltage = {-feedback_.compensation_AB_V(x), v_max_V(v_bus_V)};
