@@ -3,10 +3,10 @@
 ///   double: the standard library's, so that the host's double runs keep their exactness.
 ///   float:  the quotient of the smaller by the larger component, Cephes' atanf reduction and
 ///           polynomial on [0, tan(pi/8)], and the octant's offset. newlib's atan2f with the
-///           atanf it calls is 756 B of the board image's flash; this is a fifth of that.
+///           atanf it calls is 756 B of the board image's flash; this, under half of that.
 /// The float result is within 2^-20 rad of the exact angle of the float vector (the bound's
-/// terms: tests/control/test_atan2.cpp). A zero vector gives 0; a non-finite component gives
-/// NaN unless the other is finite and the vector lies along an axis.
+/// terms: tests/control/test_atan2.cpp). A zero vector gives 0; one infinite component beside a
+/// finite one gives that axis's angle; a NaN or two infinite components give NaN.
 #include <cmath>
 
 namespace imd::control {
