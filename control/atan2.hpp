@@ -18,8 +18,8 @@ inline double atan2_rad(double y, double x) noexcept {
 inline float atan2_rad(float y, float x) noexcept {
   const float ay = std::fabs(y), ax = std::fabs(x);
   const float big = ay > ax ? ay : ax, small = ay > ax ? ax : ay;
-  if (big == 0.0f) return 0.0f;
-  float t = small / big;  // in [0, 1]
+  if (big == 0.0f) return small;  // +0 for a zero vector, NaN beside a NaN
+  float t = small / big;          // in [0, 1]
   float offset = 0.0f;
   if (t > 0.414213562f) {  // tan(pi/8): atan t = pi/4 + atan((t - 1) / (t + 1))
     t = (t - 1.0f) / (t + 1.0f);

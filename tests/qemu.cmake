@@ -50,7 +50,8 @@ set_tests_properties(qemu_python_client PROPERTIES LABELS qemu RUN_SERIAL ON TIM
 # Processor in the loop: the Cortex-M4F image on QEMU's mps2-an386 (tests/qemu/pil_test.py),
 # built with the bare-metal toolchain in its own tree, with the cortex-m4f preset's flags. The
 # same tree builds the two STM32G431 images, so that the test job also holds them to their
-# budgets (the linker's), tick-path and stack checks: CI builds the Cortex-M4F code only here.
+# budgets (the linker's), tick-path and stack checks: CI builds the Cortex-M4F code only here
+# and in the run-image trees below.
 find_program(IMD_ARM_NONE_EABI_CXX arm-none-eabi-g++)
 if(IMD_ARM_NONE_EABI_CXX)
   ExternalProject_Add(qemu_programs_cortex_m4f
@@ -69,10 +70,11 @@ if(IMD_ARM_NONE_EABI_CXX)
     ExternalProject_Add(run_image_${law}
       SOURCE_DIR ${PROJECT_SOURCE_DIR}
       BINARY_DIR ${CMAKE_BINARY_DIR}/run-image-${law}
-      CMAKE_ARGS -DCMAKE_TOOLCHAIN_FILE=${PROJECT_SOURCE_DIR}/toolchains/arm-none-eabi-cortex-m4f.cmake
-                 -DCMAKE_BUILD_TYPE=Release "-DCMAKE_CXX_FLAGS_RELEASE=-O2 -g -DNDEBUG"
-                 -DIMD_BUILD_TESTS=OFF -DIMD_BUILD_BENCHMARKS=OFF -DIMD_WARNINGS_AS_ERRORS=ON
-                 -DIMD_BOARD_LAWS=${law}
+      CMAKE_ARGS
+        -DCMAKE_TOOLCHAIN_FILE=${PROJECT_SOURCE_DIR}/toolchains/arm-none-eabi-cortex-m4f.cmake
+        -DCMAKE_BUILD_TYPE=Release "-DCMAKE_CXX_FLAGS_RELEASE=-O2 -g -DNDEBUG"
+        -DIMD_BUILD_TESTS=OFF -DIMD_BUILD_BENCHMARKS=OFF -DIMD_WARNINGS_AS_ERRORS=ON
+        -DIMD_BOARD_LAWS=${law}
       BUILD_COMMAND ${CMAKE_COMMAND} --build <BINARY_DIR> --target drive_stm32g431
       INSTALL_COMMAND ""
       BUILD_ALWAYS ON)
