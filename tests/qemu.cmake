@@ -54,12 +54,15 @@ set_tests_properties(qemu_python_client PROPERTIES LABELS qemu RUN_SERIAL ON TIM
 # and in the run-image trees below.
 find_program(IMD_ARM_NONE_EABI_CXX arm-none-eabi-g++)
 if(IMD_ARM_NONE_EABI_CXX)
+  # Every Cortex-M4F tree the same way: the cortex-m4f preset's flags, warnings as errors.
+  set(cortex_m4f_args
+      -DCMAKE_TOOLCHAIN_FILE=${PROJECT_SOURCE_DIR}/toolchains/arm-none-eabi-cortex-m4f.cmake
+      -DCMAKE_BUILD_TYPE=Release "-DCMAKE_CXX_FLAGS_RELEASE=-O2 -g -DNDEBUG"
+      -DIMD_BUILD_TESTS=OFF -DIMD_BUILD_BENCHMARKS=OFF -DIMD_WARNINGS_AS_ERRORS=ON)
   ExternalProject_Add(qemu_programs_cortex_m4f
     SOURCE_DIR ${PROJECT_SOURCE_DIR}
     BINARY_DIR ${CMAKE_BINARY_DIR}/qemu-cortex-m4f
-    CMAKE_ARGS -DCMAKE_TOOLCHAIN_FILE=${PROJECT_SOURCE_DIR}/toolchains/arm-none-eabi-cortex-m4f.cmake
-               -DCMAKE_BUILD_TYPE=Release "-DCMAKE_CXX_FLAGS_RELEASE=-O2 -g -DNDEBUG"
-               -DIMD_BUILD_TESTS=OFF -DIMD_BUILD_BENCHMARKS=OFF -DIMD_WARNINGS_AS_ERRORS=ON
+    CMAKE_ARGS ${cortex_m4f_args}
     BUILD_COMMAND ${CMAKE_COMMAND} --build <BINARY_DIR>
                   --target drive_pil_mps2_an386 drive_stm32g431 commission_stm32g431
     INSTALL_COMMAND ""
@@ -70,11 +73,7 @@ if(IMD_ARM_NONE_EABI_CXX)
     ExternalProject_Add(run_image_${law}
       SOURCE_DIR ${PROJECT_SOURCE_DIR}
       BINARY_DIR ${CMAKE_BINARY_DIR}/run-image-${law}
-      CMAKE_ARGS
-        -DCMAKE_TOOLCHAIN_FILE=${PROJECT_SOURCE_DIR}/toolchains/arm-none-eabi-cortex-m4f.cmake
-        -DCMAKE_BUILD_TYPE=Release "-DCMAKE_CXX_FLAGS_RELEASE=-O2 -g -DNDEBUG"
-        -DIMD_BUILD_TESTS=OFF -DIMD_BUILD_BENCHMARKS=OFF -DIMD_WARNINGS_AS_ERRORS=ON
-        -DIMD_BOARD_LAWS=${law}
+      CMAKE_ARGS ${cortex_m4f_args} -DIMD_BOARD_LAWS=${law}
       BUILD_COMMAND ${CMAKE_COMMAND} --build <BINARY_DIR> --target drive_stm32g431
       INSTALL_COMMAND ""
       BUILD_ALWAYS ON)
