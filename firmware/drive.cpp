@@ -179,11 +179,16 @@ template <typename T>
 inline Estimate<T> Drive<T>::estimate(const Measurement<T>& m, MotorModel<T>* model) noexcept {
   // While the commissioning drives the motor the model's observers have nothing to follow.
   if (!m.valid || model == nullptr || supervisor_.state() == DriveState::identifying) return {};
+  return observe(m, *model);
+}
+
+template <typename T>
+inline Estimate<T> Drive<T>::observe(const Measurement<T>& m, MotorModel<T>& model) noexcept {
   // The board's own estimator is called as its final class: a direct call the compiler may
   // inline, not a virtual one (likewise its power stage in modulate and actuate).
   Estimate<T> e = substitutes_.estimator != nullptr ? substitutes_.estimator->estimate(m)
-                                                    : model->observers.estimate(m);
-  model->predictor.set_input_state(e);
+                                                    : model.observers.estimate(m);
+  model.predictor.set_input_state(e);
   // The rotor resistance moves only while a law runs on a magnetized motor (decided now, on the
   // state the estimate was made in; the tracker steps after the PWM write).
   tracker_due_ = true;
@@ -231,9 +236,8 @@ inline LawOutput<T> Drive<T>::law(const TickPlan<T>& plan, const Estimate<T>& e,
     return model->magnetizer.step(e.x_input, plan.next, supervisor_.controlled_flux(), feasible);
   }
   const T v_max_V = model->limits.v_max_V(v_bus_V);
-  const LawOutput<T> out = supervisor_.law().step(
-      {e, plan.now, plan.next, plan.ahead, plan.stopping, feasible, v_max_V}, record_.law);
-  return out;
+  const LawInput<T> in{e, plan.now, plan.next, plan.ahead, plan.stopping, feasible, v_max_V};
+  return supervisor_.law().step(in, record_.law);
 }
 
 template <typename T>

@@ -131,6 +131,10 @@ class Drive final : public hal::TickHandler {
   void rebuild(const control::MotorParameters& motor) noexcept;
   [[gnu::always_inline]] Estimate<T> estimate(const Measurement<T>& m,
                                               MotorModel<T>* model) noexcept;
+  /// estimate() of a valid measurement with a model: one named result, built in its caller's
+  /// place (a function that also returns another object would copy it there).
+  [[gnu::always_inline]] Estimate<T> observe(const Measurement<T>& m,
+                                             MotorModel<T>& model) noexcept;
   [[gnu::always_inline]] LawOutput<T> law(const TickPlan<T>& plan, const Estimate<T>& e,
                                           T v_bus_V, MotorModel<T>* model) noexcept;
   [[gnu::always_inline]] Modulation<T> modulate(const TickPlan<T>& plan, const LawOutput<T>& u,

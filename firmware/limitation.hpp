@@ -60,12 +60,17 @@ class LimitedMonitor {
 
   /// The limit of this tick (none when nothing held the law back, or when not running).
   void update(Limitation now) noexcept {
+    // Free, with nothing held and the shares at zero: the update would leave all as it is.
+    // The common tick; it then skips the three shares' arithmetic.
+    if (now == Limitation::none && quiet_) return;
     // Each reason's share of the recent ticks (a first-order average over the window): the
     // reason reported is the one that dominates, so that ticks alternating between the
     // voltage and the current disk do not flip it.
+    bool negligible = now == Limitation::none;
     for (int r = 0; r < kReasons; ++r) {
       const float hit = int(now) == r + 1 ? 1.0f : 0.0f;
       share_[r] += (hit - share_[r]) * rate_;
+      negligible = negligible && share_[r] < rate_ * kNegligibleShare;
     }
     if (now != Limitation::none) {
       level_ = std::min(level_ + 1, window_);
@@ -73,11 +78,22 @@ class LimitedMonitor {
     } else if (level_ > 0 && --level_ == 0) {
       limited_ = Limitation::none;
     }
+    // A share decays towards zero without reaching it (in float it stops at a denormal near
+    // 2^-141 for a window of 400 ticks). Once every share is below a millionth of one tick's
+    // weight, none can decide dominant(): the next limited tick adds a whole tick's weight to
+    // its reason. They are then zero, and the monitor quiet until a limit comes.
+    if (negligible && level_ == 0) {
+      for (float& share : share_) share = 0.0f;
+      quiet_ = true;
+    } else {
+      quiet_ = false;
+    }
   }
   void reset() noexcept {
     level_ = 0;
     limited_ = Limitation::none;
     for (float& share : share_) share = 0.0f;
+    quiet_ = true;
   }
   /// The limitation in force, none if there is none. It clears a window after the last
   /// limited tick, and until then keeps its reason.
@@ -85,6 +101,8 @@ class LimitedMonitor {
 
  private:
   static constexpr int kReasons = 3;  ///< voltage, current, torque
+  /// A share below this many ticks' weight (rate_) counts as none.
+  static constexpr float kNegligibleShare = 1e-6f;
   Limitation dominant() const noexcept {
     int best = 0;
     for (int r = 1; r < kReasons; ++r) {
@@ -98,6 +116,7 @@ class LimitedMonitor {
   uint32_t level_ = 0;
   Limitation limited_ = Limitation::none;
   float share_[kReasons] = {0.0f, 0.0f, 0.0f};
+  bool quiet_ = true;  ///< level_ 0, limited_ none, every share zero
 };
 
 }  // namespace imd::firmware

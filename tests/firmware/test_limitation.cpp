@@ -2,7 +2,9 @@
 // rule, and which limit an input on the edge of the feasible set presses against.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <random>
 
 #include "control/voltage_fed_model.hpp"
 #include "firmware/drive_config.hpp"
@@ -65,6 +67,70 @@ TEST(LimitedMonitor, IgnoresALimitTouchedInLessThanHalfOfTheTicks) {
   EXPECT_EQ(m.limited(), Limitation::torque);
   m.reset();
   EXPECT_EQ(m.limited(), Limitation::none);
+}
+
+/// The monitor as it was before it skipped its quiet ticks: every share updated every tick.
+class UpdatedEveryTick {
+ public:
+  explicit UpdatedEveryTick(uint32_t window) : window_(window), rate_(1.0f / float(window)) {}
+  void update(Limitation now) {
+    for (int r = 0; r < 3; ++r) {
+      share_[r] += ((int(now) == r + 1 ? 1.0f : 0.0f) - share_[r]) * rate_;
+    }
+    if (now != Limitation::none) {
+      level_ = std::min(level_ + 1, window_);
+      if (level_ == window_ || limited_ != Limitation::none) {
+        int best = 0;
+        for (int r = 1; r < 3; ++r) best = share_[r] > share_[best] ? r : best;
+        limited_ = Limitation(best + 1);
+      }
+    } else if (level_ > 0 && --level_ == 0) {
+      limited_ = Limitation::none;
+    }
+  }
+  Limitation limited() const { return limited_; }
+
+ private:
+  uint32_t window_;
+  float rate_;
+  uint32_t level_ = 0;
+  Limitation limited_ = Limitation::none;
+  float share_[3] = {0.0f, 0.0f, 0.0f};
+};
+
+TEST(LimitedMonitor, SkippingQuietTicksReportsWhatUpdatingEveryTickReports) {
+  // Bursts of limits (each reason, mixed, of random lengths and densities) between free
+  // stretches long enough for the shares to fall to nothing (up to 40 windows), 2 million
+  // ticks: the same report every tick. The skip leaves out only ticks whose update changes
+  // nothing but shares below a millionth of a tick's weight.
+  std::mt19937 rng(7);
+  for (const uint32_t window : {4u, 127u, kWindow, 800u}) {
+    LimitedMonitor skipping(window);
+    UpdatedEveryTick every(window);
+    uint64_t k = 0, limited_ticks = 0;
+    while (k < 2'000'000) {
+      const uint32_t burst = std::uniform_int_distribution<uint32_t>(1, 4 * window)(rng);
+      const float density = std::uniform_real_distribution<float>(0.2f, 1.0f)(rng);
+      const int reasons = std::uniform_int_distribution<int>(1, 3)(rng);
+      for (uint32_t i = 0; i < burst; ++i, ++k) {
+        const bool hit = std::uniform_real_distribution<float>(0, 1)(rng) < density;
+        const Limitation now =
+            hit ? Limitation(std::uniform_int_distribution<int>(1, reasons)(rng))
+                : Limitation::none;
+        skipping.update(now);
+        every.update(now);
+        ASSERT_EQ(skipping.limited(), every.limited()) << "window " << window << " tick " << k;
+        limited_ticks += skipping.limited() != Limitation::none;
+      }
+      const uint32_t free = std::uniform_int_distribution<uint32_t>(1, 40 * window)(rng);
+      for (uint32_t i = 0; i < free; ++i, ++k) {
+        skipping.update(Limitation::none);
+        every.update(Limitation::none);
+        ASSERT_EQ(skipping.limited(), every.limited()) << "window " << window << " tick " << k;
+      }
+    }
+    EXPECT_GT(limited_ticks, 0u) << window;  // the comparison saw the report raised
+  }
 }
 
 TEST(LimitedMonitor, WindowIsFourTimeConstantsOfTheDefaultSpeedLoop) {
