@@ -98,6 +98,8 @@ class LimitedMonitor {
   /// The limitation in force, none if there is none. It clears a window after the last
   /// limited tick, and until then keeps its reason.
   Limitation limited() const noexcept { return limited_; }
+  /// Whether the next free tick is skipped: nothing limited, and every share at zero.
+  bool quiet() const noexcept { return quiet_; }
 
  private:
   static constexpr int kReasons = 3;  ///< voltage, current, torque

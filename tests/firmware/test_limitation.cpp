@@ -107,7 +107,7 @@ TEST(LimitedMonitor, SkippingQuietTicksReportsWhatUpdatingEveryTickReports) {
   for (const uint32_t window : {4u, 127u, kWindow, 800u}) {
     LimitedMonitor skipping(window);
     UpdatedEveryTick every(window);
-    uint64_t k = 0, limited_ticks = 0;
+    uint64_t k = 0, limited_ticks = 0, quiet_stretches = 0;
     while (k < 2'000'000) {
       const uint32_t burst = std::uniform_int_distribution<uint32_t>(1, 4 * window)(rng);
       const float density = std::uniform_real_distribution<float>(0.2f, 1.0f)(rng);
@@ -128,8 +128,10 @@ TEST(LimitedMonitor, SkippingQuietTicksReportsWhatUpdatingEveryTickReports) {
         every.update(Limitation::none);
         ASSERT_EQ(skipping.limited(), every.limited()) << "window " << window << " tick " << k;
       }
+      quiet_stretches += skipping.quiet();
     }
     EXPECT_GT(limited_ticks, 0u) << window;  // the comparison saw the report raised
+    EXPECT_GT(quiet_stretches, 0u) << window;  // and ticks skipped
   }
 }
 
