@@ -23,8 +23,11 @@ class LatencyPredictor {
   /// Sets e.x_input, the state the input of this tick will act on.
   void set_input_state(Estimate<T>& e) noexcept {
     if (predict_) {
-      next_ = model_.predict(e.x, v_in_flight_V_, e.load_Nm);
-      e.x_input = next_;
+      // Stored from registers twice: copied from next_, each value would be read back (the
+      // estimate's floats may alias the predictor's for the compiler).
+      const control::RotorFrameState<T> next = model_.predict(e.x, v_in_flight_V_, e.load_Nm);
+      next_ = next;
+      e.x_input = next;
     } else {
       e.x_input = e.x;
     }
