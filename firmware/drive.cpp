@@ -3,14 +3,10 @@
 #include "control/svpwm.hpp"
 #include "firmware/duration_ticks.hpp"
 
-#include <algorithm>
-#include <cmath>
 #include <numbers>
 
 namespace imd::firmware {
-
 namespace {
-
 template <typename T>
 std::optional<MotorModel<T>> build(const std::optional<MotorRecord>& record,
                                    const DriveConfig& config, const BoardScales& board) {
