@@ -118,7 +118,9 @@ class LimitedMonitor {
   uint32_t level_ = 0;
   Limitation limited_ = Limitation::none;
   float share_[kReasons] = {0.0f, 0.0f, 0.0f};
-  bool quiet_ = true;  ///< level_ 0, limited_ none, every share zero
+  /// level_ 0, limited_ none, every share zero: derivable, kept so that a quiet tick tests one
+  /// flag rather than three shares.
+  bool quiet_ = true;
 };
 
 }  // namespace imd::firmware
