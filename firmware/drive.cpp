@@ -65,7 +65,7 @@ void Drive<T>::on_tick() noexcept {
   const Vec2 u_acted_V = u_last_period_V_;  // over [k-1, k]: the tracker's, after the write
   const Estimate<T> e = estimate(m, model);
   clock.lap(Stage::estimate);
-  const TickPlan<T> plan = supervisor_.plan(k, m, e);
+  const TickPlan<T>& plan = supervisor_.plan(k, m, e);  // valid until prepare(k) below
   // A hardware trip is forgotten only when its fault is cleared (and found again at once if
   // the comparator still holds the break input).
   if (plan.restarted) hw_.pwm.clear_trip();
@@ -88,8 +88,8 @@ void Drive<T>::on_tick() noexcept {
   react(k, e, out, trip, overrun, law_voltage, model);
   clock.lap(Stage::protect);
   after_write(m, e, plan.mode == Mode::controlling && model != nullptr, u_acted_V, model);
-  supervisor_.prepare(k);  // the next tick's references, off the path to its write
   publish(k, m, e, plan, u, out, model);
+  supervisor_.prepare(k);  // the next tick's plan, off the path to its write
   end_identification(k);
   if (bank_.apply_wanted()) release_model();
   clock.lap(Stage::publish);

@@ -48,7 +48,7 @@ Supervisor<T>::Supervisor(const DriveConfig& config, const SupervisorWiring& wir
   select(controller_);
   if (calibrated_) {
     machine_.go(rest_state(), TransitionReason::calibrated, 0);
-    TickPlan<T> unused;
+    bool unused = false;
     if (auto_enable_) enable(0, unused);
   }
   status_.state = machine_.state();
@@ -64,7 +64,7 @@ void Supervisor<T>::attach(LawRegistry<T>* laws, const Magnetizer<T>* magnetizer
   select(controller_);
   if (machine_.state() != DriveState::unconfigured) return;  // e.g. a fault came meanwhile
   if (machine_.go(DriveState::idle, TransitionReason::configured, k) && auto_enable_) {
-    TickPlan<T> unused;
+    bool unused = false;
     enable(k, unused);
   }
   status_.state = machine_.state();
@@ -98,18 +98,34 @@ bool Supervisor<T>::read_enable_input() const noexcept {
 }
 
 template <typename T>
-TickPlan<T> Supervisor<T>::plan(uint64_t k, const Measurement<T>& m,
-                                const Estimate<T>& e) noexcept {
-  TickPlan<T> p;
-  p.mode = Mode::off;
-  p.stopping = false;
+const TickPlan<T>& Supervisor<T>::plan(uint64_t k, const Measurement<T>& m,
+                                       const Estimate<T>& e) noexcept {
   enable_input_ = read_enable_input();  // before the commands: enable needs it
   v_bus_V_ = m.v_bus_V;
-  receive_commands(k, p);
+  bool restarted = false;
+  if (wiring_.can != nullptr) receive_commands(k, restarted);
+  // Running on with nothing applied since prepare(k - 1) (a command, a fault, a model attached
+  // bump the generation): its plan is this tick's, whole.
+  if (prepared_.k == k && prepared_.generation == generation_ && e.valid &&
+      machine_.state() == DriveState::running && !fault_stop_) {
+    ramp_.reset(prepared_.ramp_k1_rad_s);
+    return prepared_.plan;
+  }
+  return replan(k, m, e, restarted);
+}
+
+template <typename T>
+const TickPlan<T>& Supervisor<T>::replan(uint64_t k, const Measurement<T>& m,
+                                         const Estimate<T>& e, bool restarted) noexcept {
+  TickPlan<T>& p = plan_;
+  p = TickPlan<T>{};
+  p.mode = Mode::off;
+  p.stopping = false;
+  p.restarted = restarted;
   if (machine_.state() == DriveState::calibrating && m.calibration == Calibration::done) {
     calibrated_ = true;
     machine_.go(rest_state(), TransitionReason::calibrated, k);
-    if (auto_enable_) enable(k + 1, p);
+    if (auto_enable_) enable(k + 1, p.restarted);
   }
   if (machine_.state() == DriveState::identifying) {
     p.mode = Mode::identifying;
@@ -174,14 +190,6 @@ inline void Supervisor<T>::references(uint64_t k, const Estimate<T>& e, TickPlan
   // reference, so that the reaching law acts on the real error from the first running tick.
   // Stopping ramps the speed to zero at the stop deceleration.
   p.stopping = machine_.state() == DriveState::stopping;
-  // The ramp's value needs no test: only this function moves it.
-  if (prepared_.k == k && prepared_.generation == generation_ &&
-      machine_.state() == DriveState::running) {
-    p.now = prepared_.now;  // read ahead by prepare(k - 1), after the last write
-    p.next = prepared_.next;
-    ramp_.reset(prepared_.ramp_k1_rad_s);
-    return;
-  }
   if (machine_.state() == DriveState::magnetizing) {
     ramp_.reset(ramp_.limited()
                     ? e.x.omega_mech_rad_s
@@ -213,9 +221,19 @@ template <typename T>
 void Supervisor<T>::prepare(uint64_t k) noexcept {
   prepared_.k = Prepared::kNotPrepared;
   // Running: plan(k + 1) neither resets the ramp nor stops (a stop begins with a command or a
-  // fault, each of which bumps the generation).
+  // fault, each of which bumps the generation). The plan is the one plan() builds running.
   if (machine_.state() != DriveState::running) return;
-  shaped(k + 1, false, prepared_.now, prepared_.next, prepared_.ramp_k1_rad_s);
+  TickPlan<T>& p = prepared_.plan;
+  p.mode = Mode::controlling;
+  p.stopping = false;
+  p.restarted = false;
+  shaped(k + 1, false, p.now, p.next, prepared_.ramp_k1_rad_s);
+  if (lookahead_ticks_ > 0) {
+    p.ahead = references_.at_tick(k + 1 + lookahead_ticks_);
+    p.ahead.omega_mech_rad_s = p.next.omega_mech_rad_s;  // through the speed ramp
+  } else {
+    p.ahead = {};
+  }
   prepared_.generation = generation_;
   prepared_.k = k + 1;
 }

@@ -78,15 +78,16 @@ class Supervisor {
   void attach(LawRegistry<T>* laws, const Magnetizer<T>* magnetizer, uint64_t k) noexcept;
 
   /// Commands, then the transitions the measurement and the estimate call for, then the
-  /// references.
-  TickPlan<T> plan(uint64_t k, const Measurement<T>& m, const Estimate<T>& e) noexcept;
+  /// references. Running on, the plan prepare(k - 1) made; the reference is valid until the
+  /// next plan() or prepare().
+  const TickPlan<T>& plan(uint64_t k, const Measurement<T>& m, const Estimate<T>& e) noexcept;
   /// What the checks need of tick k's plan p, after the PWM write (off the latency from sense
   /// to write; nothing between the plan and the checks changes the state).
   SupervisedState supervised(uint64_t k, const TickPlan<T>& p) const noexcept;
-  /// After tick k's PWM write and trip decisions: the references tick k + 1 takes if the drive
-  /// runs on, read ahead off the path to the next write. plan(k + 1) takes them unless what
-  /// they depend on changed meanwhile (a command, a fault, a transition, the ramp), and then
-  /// computes them itself: the same values either way.
+  /// After tick k's PWM write and trip decisions: the plan tick k + 1 takes if the drive runs
+  /// on, made off the path to the next write. plan(k + 1) takes it unless what it depends on
+  /// changed meanwhile (a command, a fault, a transition, the ramp), and then makes its own:
+  /// the same plan either way.
   void prepare(uint64_t k) noexcept;
   /// Latches the faults the protect stage found (the first one keeps its code and time) and
   /// starts their stop (firmware/protection/stop_category.hpp). True: STO, the caller turns the
@@ -134,11 +135,16 @@ class Supervisor {
   [[gnu::noinline]] void shaped(uint64_t k, bool stopping, Reference<T>& now, Reference<T>& next,
                                 T& ramp_k1_rad_s) const noexcept;
   // Commands (supervisor_commands.cpp).
-  void receive_commands(uint64_t k, TickPlan<T>& p) noexcept;
+  /// The parameter bank's answer and the CAN commands (with a CAN bus only).
+  void receive_commands(uint64_t k, bool& restarted) noexcept;
+  /// The plan made afresh (plan() without a prepared one to take). Not inlined: the running
+  /// tick's path through plan() stays a short function.
+  [[gnu::noinline]] const TickPlan<T>& replan(uint64_t k, const Measurement<T>& m,
+                                              const Estimate<T>& e, bool restarted) noexcept;
   protocol::CommandResult apply(const protocol::Command& command, uint64_t k,
-                                TickPlan<T>& p) noexcept;
-  void enable(uint64_t k, TickPlan<T>& p) noexcept;
-  protocol::CommandResult clear_faults(uint64_t k, TickPlan<T>& p) noexcept;
+                                bool& restarted) noexcept;
+  void enable(uint64_t k, bool& restarted) noexcept;
+  protocol::CommandResult clear_faults(uint64_t k, bool& restarted) noexcept;
   /// A fault's controlled stop ended (at standstill, or at its time limit): STO.
   void end_fault_stop(uint64_t k, TickPlan<T>& p) noexcept;
   bool read_enable_input() const noexcept;
@@ -148,7 +154,7 @@ class Supervisor {
     return laws_ != nullptr ? DriveState::idle : DriveState::unconfigured;
   }
   protocol::CommandResult access_parameter(const protocol::Command& c, uint64_t k,
-                                           TickPlan<T>& p) noexcept;
+                                           bool& restarted) noexcept;
   /// The answers the service loop has ready; a write that completed a record starts the
   /// change of model (idle -> unconfigured).
   void answer_served_access(uint64_t k) noexcept;
@@ -181,14 +187,15 @@ class Supervisor {
   /// Bumped by whatever changes the references or the ramp's limit (a command applied, an
   /// enable, a fault latched), and by a model attached, which drops a read-ahead to be safe.
   uint32_t generation_ = 0;
-  /// The references prepare() read ahead for tick `k` (kNotPrepared: none).
+  /// The plan prepare() made for tick `k` (kNotPrepared: none).
   struct Prepared {
     static constexpr uint64_t kNotPrepared = UINT64_MAX;
     uint64_t k = kNotPrepared;
     uint32_t generation = 0;
-    T ramp_k1_rad_s = T(0);  ///< the ramp's value they leave
-    Reference<T> now, next;
+    T ramp_k1_rad_s = T(0);  ///< the ramp's value it leaves
+    TickPlan<T> plan{};
   } prepared_;
+  TickPlan<T> plan_{};  ///< the plan plan() made itself
   uint64_t magnetizing_start_tick_ = 0, last_command_tick_ = 0, stop_start_tick_ = 0;
 };
 

@@ -11,16 +11,17 @@ namespace imd::firmware {
 inline constexpr int kMaxFramesPerTick = 4;
 
 template <typename T>
-void Supervisor<T>::receive_commands(uint64_t k, TickPlan<T>& p) noexcept {
-  if (wiring_.can == nullptr) return;
-  answer_served_access(k);
+void Supervisor<T>::receive_commands(uint64_t k, bool& restarted) noexcept {
+  // The bank's stage read here: most ticks have no answer to take.
+  const ParameterBank* bank = wiring_.parameters;
+  if (bank != nullptr && bank->stage() == ParameterBank::Stage::answered) answer_served_access(k);
   hal::CanFrame frame;
   for (int n = 0; n < kMaxFramesPerTick && wiring_.can->try_receive(frame); ++n) {
     protocol::Decoded d = decoder_.decode(frame);
     if (!d.for_this_node) continue;
     if (d.result == protocol::CommandResult::accepted) {
       last_command_tick_ = k;  // any valid command feeds the watchdog
-      d.result = apply(d.command, k, p);
+      d.result = apply(d.command, k, restarted);
       if (d.result != protocol::CommandResult::accepted) decoder_.count_refused(d.result);
     }
     wiring_.telemetry.acknowledge(*wiring_.can, d, decoder_.rejected_total());
@@ -28,17 +29,17 @@ void Supervisor<T>::receive_commands(uint64_t k, TickPlan<T>& p) noexcept {
 }
 
 template <typename T>
-void Supervisor<T>::enable(uint64_t k, TickPlan<T>& p) noexcept {
+void Supervisor<T>::enable(uint64_t k, bool& restarted) noexcept {
   ++generation_;  // the ramp's limit
   if (!machine_.go(DriveState::magnetizing, TransitionReason::enable, k)) return;
   magnetizing_start_tick_ = k;
   last_command_tick_ = k;
   ramp_.set_max_step(command_accel_step_rad_s_);
-  p.restarted = true;
+  restarted = true;
 }
 
 template <typename T>
-protocol::CommandResult Supervisor<T>::clear_faults(uint64_t k, TickPlan<T>& p) noexcept {
+protocol::CommandResult Supervisor<T>::clear_faults(uint64_t k, bool& restarted) noexcept {
   // Not before a fault's controlled stop has ended in STO; without a fault, nothing to clear.
   if (fault_stop_) return protocol::CommandResult::not_allowed;
   if (machine_.state() != DriveState::fault) return protocol::CommandResult::accepted;
@@ -51,13 +52,13 @@ protocol::CommandResult Supervisor<T>::clear_faults(uint64_t k, TickPlan<T>& p) 
   status_.first_fault = FaultCode::none;
   status_.fault_detail = 0;
   status_.stop = StopCategory::none;
-  p.restarted = true;
+  restarted = true;
   return protocol::CommandResult::accepted;
 }
 
 template <typename T>
 protocol::CommandResult Supervisor<T>::apply(const protocol::Command& c, uint64_t k,
-                                             TickPlan<T>& p) noexcept {
+                                             bool& restarted) noexcept {
   using protocol::CommandKind;
   using protocol::CommandResult;
   ++generation_;  // any command may change the references, the ramp or the state
@@ -75,7 +76,7 @@ protocol::CommandResult Supervisor<T>::apply(const protocol::Command& c, uint64_
       if (wiring_.parameters != nullptr && wiring_.parameters->busy()) {
         return CommandResult::not_allowed;
       }
-      if (s == DriveState::idle) enable(k, p);
+      if (s == DriveState::idle) enable(k, restarted);
       return s == DriveState::idle || s == DriveState::magnetizing || s == DriveState::running
                  ? CommandResult::accepted
                  : CommandResult::not_allowed;
@@ -92,7 +93,7 @@ protocol::CommandResult Supervisor<T>::apply(const protocol::Command& c, uint64_
       }
       return CommandResult::accepted;
     case CommandKind::clear_faults:
-      return clear_faults(k, p);
+      return clear_faults(k, restarted);
     case CommandKind::set_speed:
       if (!commands_over_can_) return CommandResult::not_allowed;
       commanded_.set_speed(T(c.value));
@@ -122,7 +123,7 @@ protocol::CommandResult Supervisor<T>::apply(const protocol::Command& c, uint64_
                  ? CommandResult::accepted
                  : CommandResult::out_of_range;
     case CommandKind::parameter_access:
-      return access_parameter(c, k, p);
+      return access_parameter(c, k, restarted);
     case CommandKind::identify: {
       if (!kCommissioningInImage) return CommandResult::not_in_image;
       // Planned from the record's nameplate by the service loop (Drive::service); running
@@ -151,7 +152,7 @@ protocol::CommandResult Supervisor<T>::apply(const protocol::Command& c, uint64_
 
 template <typename T>
 protocol::CommandResult Supervisor<T>::access_parameter(const protocol::Command& c, uint64_t,
-                                                        TickPlan<T>&) noexcept {
+                                                        bool&) noexcept {
   using protocol::CommandResult;
   ParameterBank* bank = wiring_.parameters;
   if (bank == nullptr) return CommandResult::not_allowed;
@@ -219,13 +220,13 @@ void Supervisor<T>::answer_parameter(const ParameterAnswer& a) noexcept {
 
 // The class is instantiated in supervisor.cpp; these members are defined here.
 #define IMD_INSTANTIATE_COMMANDS(T)                                                         \
-  template void Supervisor<T>::receive_commands(uint64_t, TickPlan<T>&) noexcept;           \
-  template void Supervisor<T>::enable(uint64_t, TickPlan<T>&) noexcept;                     \
-  template protocol::CommandResult Supervisor<T>::clear_faults(uint64_t, TickPlan<T>&) noexcept; \
+  template void Supervisor<T>::receive_commands(uint64_t, bool&) noexcept;                  \
+  template void Supervisor<T>::enable(uint64_t, bool&) noexcept;                     \
+  template protocol::CommandResult Supervisor<T>::clear_faults(uint64_t, bool&) noexcept; \
   template protocol::CommandResult Supervisor<T>::apply(const protocol::Command&, uint64_t, \
-                                                        TickPlan<T>&) noexcept;            \
+                                                        bool&) noexcept;                   \
   template protocol::CommandResult Supervisor<T>::access_parameter(                         \
-      const protocol::Command&, uint64_t, TickPlan<T>&) noexcept;                           \
+      const protocol::Command&, uint64_t, bool&) noexcept;                                  \
   template void Supervisor<T>::answer_served_access(uint64_t) noexcept;                     \
   template void Supervisor<T>::answer_parameter(const ParameterAnswer&) noexcept;
 IMD_INSTANTIATE_COMMANDS(float)

@@ -27,8 +27,8 @@ struct Constant final : ReferenceSource<double> {
 struct Varying final : ReferenceSource<double> {
   Reference<double> at_tick(uint64_t k) const noexcept override {
     ++reads;
-    return {30.0 + 20.0 * std::sin(double(k) / 100.0), 0.2 + 0.01 * double((k / 50) % 3), 0.0,
-            1.0};
+    return {30.0 + 20.0 * std::sin(double(k) / 100.0), 0.2 + 0.01 * double((k / 50) % 3),
+            5.0 * std::cos(double(k) / 70.0), 0.15};
   }
   mutable int reads = 0;
 };
@@ -47,16 +47,18 @@ struct Bench {
   Measurement<double> m;
   Estimate<double> e;
 
-  static DriveConfig make_config(bool over_can) {
+  static DriveConfig make_config(bool over_can, ControllerKind controller) {
     DriveConfig c;
+    c.controller = controller;
     c.max_accel_rad_s2 = 1000.0;  // 0.1 rad/s per tick
     c.adc_calibration_ticks = 0;  // the offsets are nominal: idle at once
     c.auto_enable = !over_can;
     c.commands_over_can = over_can;
     return c;
   }
-  explicit Bench(bool over_can = false, const ReferenceSource<double>* source = nullptr)
-      : config(make_config(over_can)),
+  explicit Bench(bool over_can = false, const ReferenceSource<double>* source = nullptr,
+                 ControllerKind controller = ControllerKind::dsmc)
+      : config(make_config(over_can, controller)),
         coefficients(control::discretize_voltage_fed(test::paper_motor(), 1e-4)),
         laws(LawContext{test::paper_motor(), config, coefficients}),
         magnetizer(test::paper_motor(), coefficients, config),
@@ -173,12 +175,14 @@ TEST(Supervisor, TheSetFluxCommandSetsTheSelectedLawsFlux) {
   EXPECT_NEAR(p.next.flux2_Wb2, 0.3, 1e-7);
 }
 
-/// The same references, bit for bit, from a plan that takes what prepare() read ahead and
-/// from one that reads them itself.
+/// The same plan, bit for bit, from a supervisor that takes what prepare() made and from one
+/// that makes it itself.
 void expect_same_plan(const TickPlan<double>& a, const TickPlan<double>& b, uint64_t k) {
   ASSERT_EQ(a.mode, b.mode) << k;
   ASSERT_EQ(a.stopping, b.stopping) << k;
-  for (const auto& [x, y] : {std::pair{a.now, b.now}, std::pair{a.next, b.next}}) {
+  ASSERT_EQ(a.restarted, b.restarted) << k;
+  for (const auto& [x, y] :
+       {std::pair{a.now, b.now}, std::pair{a.next, b.next}, std::pair{a.ahead, b.ahead}}) {
     ASSERT_EQ(x.omega_mech_rad_s, y.omega_mech_rad_s) << k;
     ASSERT_EQ(x.flux2_Wb2, y.flux2_Wb2) << k;
     ASSERT_EQ(x.torque_Nm, y.torque_Nm) << k;
@@ -186,9 +190,12 @@ void expect_same_plan(const TickPlan<double>& a, const TickPlan<double>& b, uint
   }
 }
 
-TEST(Supervisor, ReferencesReadAheadAfterTheWriteAreThoseThePlanWouldRead) {
+class SupervisorReadAhead : public testing::TestWithParam<ControllerKind> {};
+
+// The DSMC looks no further than the next step; the IOL a PWM period ahead (its `ahead`).
+TEST_P(SupervisorReadAhead, ThePlanMadeAfterTheWriteIsTheOneThePlanWouldMake) {
   Varying ahead_source, direct_source;
-  Bench ahead(false, &ahead_source), direct(false, &direct_source);
+  Bench ahead(false, &ahead_source, GetParam()), direct(false, &direct_source, GetParam());
   int taken = 0, running = 0;
   for (uint64_t k = 1; k <= 3000; ++k) {
     for (Bench* b : {&ahead, &direct}) {
@@ -211,6 +218,9 @@ TEST(Supervisor, ReferencesReadAheadAfterTheWriteAreThoseThePlanWouldRead) {
   EXPECT_GT(running, 2900);
   EXPECT_EQ(taken, running - 1);
 }
+
+INSTANTIATE_TEST_SUITE_P(Laws, SupervisorReadAhead,
+                         testing::Values(ControllerKind::dsmc, ControllerKind::iol));
 
 TEST(Supervisor, ACommandOrAFaultAfterTheReadAheadIsNotMissed) {
   Bench ahead(true), direct(true);
