@@ -57,8 +57,9 @@ SvpwmResult<T> svpwm(Vec2<T> u_alphabeta_V, T v_bus_V) noexcept {
     return result;
   }
   const T limit = svpwm_linear_limit_V(v_bus_V);
+  const T magnitude2 = u_alphabeta_V.squaredNorm();
   // Compared squared: the square root only for a vector to scale down.
-  if (!(u_alphabeta_V.squaredNorm() <= limit * limit)) {  // also catches NaN
+  if (!(magnitude2 <= limit * limit)) {  // also catches NaN
     result.clipped = true;
     const T magnitude = u_alphabeta_V.norm();
     u_alphabeta_V =
@@ -67,6 +68,15 @@ SvpwmResult<T> svpwm(Vec2<T> u_alphabeta_V, T v_bus_V) noexcept {
   const PhaseValues<T> v = inverse_clarke(u_alphabeta_V);
   const T offset = -(std::max({v[0], v[1], v[2]}) + std::min({v[0], v[1], v[2]})) / T(2);
   const T per_bus = T(1) / v_bus_V;  // one division for the three phases
+  // The duties span 0.5 -/+ (max - min) / (2 v_bus), and max - min <= sqrt(3) |u|: inside the
+  // linear range by 1e-5 of its radius they lie inside [0, 1] by 5e-6, far beyond their
+  // rounding (a few 2^-24). Only nearer the edge may rounding put one outside: clamped there.
+  if (magnitude2 <= T(1 - 2e-5) * (limit * limit)) {
+    for (int phase = 0; phase < 3; ++phase) {
+      result.duty[phase] = T(0.5) + (v[phase] + offset) * per_bus;
+    }
+    return result;
+  }
   for (int phase = 0; phase < 3; ++phase) {
     result.duty[phase] = std::clamp(T(0.5) + (v[phase] + offset) * per_bus, T(0), T(1));
   }
