@@ -14,7 +14,9 @@
 /// (docs/robustness.md). At no load the slip is zero, x = 0, Q^ does not depend on rho^, and
 /// the estimate is frozen: below |x| = min_slip_tangent, and below min_frequency_rad_s of the
 /// stator frequency, now or in the filtered powers (Q is then too small against the voltage's
-/// errors). Tick context except construction.
+/// errors). The powers are summed every tick and filtered, judged and adapted on once per block
+/// of ticks (block_ticks(): a thirty-second of the shorter time constant, at most 64 ticks).
+/// Tick context except construction.
 #include <algorithm>
 #include <cmath>
 
@@ -36,28 +38,60 @@ struct RotorResistanceMrasConfig {
   Real min_scale = Real(0.3), max_scale = Real(3.0);  ///< the estimate stays within these x Rr
 };
 
+/// Ticks summed before the filters, the tests and the adaptation run once on their means: a
+/// thirty-second of the shorter of the filter's and the adaptation's time constants. The mean
+/// delays the powers by half a block, tau / 64, which costs the adaptation's loop (crossover
+/// 1 / (4 tau_r)) a quarter of a degree of phase and shifts the filters' weights within a
+/// block by a few thousandths; at most 64 ticks, whose float sums keep 2^-18 of their terms.
+inline int mras_block_ticks(Real time_constant_s, Real sample_period_s) noexcept {
+  const Real ticks = time_constant_s / (32 * sample_period_s);
+  return ticks >= 64 ? 64 : (ticks >= 1 ? static_cast<int>(ticks) : 1);
+}
+
 template <typename T>
 class RotorResistanceMras {
+  /// What the tracker learns as it runs, and a tracker that takes over carries on from.
+  struct State {
+    Vec2<T> flux_AB_Wb = Vec2<T>::Zero();  ///< the current model's flux
+    Vec2<T> i_AB_last_A = Vec2<T>::Zero(), i_alphabeta_last_A = Vec2<T>::Zero();
+    T along_last = T(0), across_last = T(0);  ///< i.Psi^ and i x Psi^ at t_{k-1}
+    /// This block's sums: 2 Q, 2 Q^ Lr/Lm, i.Psi^ and i x Psi^ over its ticks so far.
+    T sum_q_ref = T(0), sum_q_adapt = T(0), sum_along = T(0), sum_across = T(0);
+    int in_block = 0;
+    bool block_adapts = true;  ///< allowed on each of the block's ticks so far
+    T q_ref = T(0), q_adapt = T(0), along = T(0), across = T(0);  ///< filtered
+    T tangent = T(0);
+    T pending = T(0);  ///< relative steps not yet applied to Rr_Ohm_
+    bool adapting = false;
+  };
+  struct Rates {
+    int block;  ///< ticks
+    T filter;   ///< the filters' share per block
+    T gain;     ///< the adaptation's per tick
+  };
+
  public:
   /// `motor`: the model's motor, whose Rr the estimate starts from; `nominal_Rr_Ohm`: the
   /// value the bounds min_scale and max_scale refer to (the motor record's).
   RotorResistanceMras(const MotorParameters& motor, const RotorResistanceMrasConfig& c,
                       Real nominal_Rr_Ohm) noexcept
       : period_s_(T(c.sample_period_s)),
-        Lm_H_(T(motor.Lm_H)),
+        half_Lm_H_(T(motor.Lm_H / 2)),
         Lm_over_Lr_(T(motor.Lm_H / motor.Lr_H)),
         inv_Lr_(T(1 / motor.Lr_H)),
-        sigma_over_T_(T((motor.Ls_H - motor.Lm_H * motor.Lm_H / motor.Lr_H) / c.sample_period_s)),
+        two_sigma_over_T_(
+            T(2 * (motor.Ls_H - motor.Lm_H * motor.Lm_H / motor.Lr_H) / c.sample_period_s)),
         p_(T(motor.pole_pairs)),
-        filter_(T(c.sample_period_s / filter_s(motor, c))),
-        gain_(T(c.sample_period_s / convergence_s(motor, c))),
+        rates_(rates(motor, c)),
         min_tangent_(T(c.min_slip_tangent)),
         min_frequency_(T(c.min_frequency_rad_s)),
         Rr_min_Ohm_(T(c.min_scale * nominal_Rr_Ohm)),
         Rr_max_Ohm_(T(c.max_scale * nominal_Rr_Ohm)),
         inv_nominal_(T(1 / nominal_Rr_Ohm)),
-        Rr_Ohm_(T(std::clamp(motor.Rr_Ohm, c.min_scale * nominal_Rr_Ohm,
-                             c.max_scale * nominal_Rr_Ohm))) {}
+        Rr_Ohm_(T(
+            std::clamp(motor.Rr_Ohm, c.min_scale * nominal_Rr_Ohm, c.max_scale * nominal_Rr_Ohm))) {
+    set_current_model();
+  }
 
   /// The rules' time constants for this motor (for documentation and the service loop).
   static Real filter_s(const MotorParameters& m, const RotorResistanceMrasConfig& c) noexcept {
@@ -68,18 +102,21 @@ class RotorResistanceMras {
                                              : 4 * m.Lr_H / m.Rr_Ohm;
   }
 
+  /// Ticks per block of the filters and the adaptation (mras_block_ticks()).
+  int block_ticks() const noexcept { return rates_.block; }
   T Rr_Ohm() const noexcept { return Rr_Ohm_; }
   /// The estimate over the nominal rotor resistance.
   T scale() const noexcept { return Rr_Ohm_ * inv_nominal_; }
-  /// Whether the last step adapted (excited and allowed).
-  bool adapting() const noexcept { return adapting_; }
+  /// Whether the last block adapted (excited, and allowed on each of its ticks).
+  bool adapting() const noexcept { return s_.adapting; }
   /// The slip tangent x of the filtered model, and the filtered powers (for telemetry/tests).
-  T slip_tangent() const noexcept { return tangent_; }
-  T q_reference_var() const noexcept { return q_ref_; }
-  T q_adaptive_var() const noexcept { return q_adapt_; }
-  const Vec2<T>& model_flux_AB_Wb() const noexcept { return flux_AB_Wb_; }
+  T slip_tangent() const noexcept { return s_.tangent; }
+  T q_reference_var() const noexcept { return s_.q_ref; }
+  T q_adaptive_var() const noexcept { return s_.q_adapt; }
+  const Vec2<T>& model_flux_AB_Wb() const noexcept { return s_.flux_AB_Wb; }
 
-  /// One tick. `i_alphabeta_A`, `i_AB_A`: the current measured now (t_k) in the stator and the
+  /// One tick: its powers summed into the block, which ends on every block_ticks()-th tick.
+  /// `i_alphabeta_A`, `i_AB_A`: the current measured now (t_k) in the stator and the
   /// rotor-aligned frame; `omega_mech_rad_s`: the speed estimate now, for the frequency tests;
   /// `omega_mean_rad_s`: the mean speed over [t_{k-1}, t_k] as measured (the encoder's counts
   /// over the period), for Q^; `u_alphabeta_V`: the stator voltage that acted over
@@ -94,90 +131,110 @@ class RotorResistanceMras {
   void step(const Vec2<T>& i_alphabeta_A, const Vec2<T>& i_AB_A, T omega_mech_rad_s,
             T omega_mean_rad_s, const Vec2<T>& u_alphabeta_V, bool adapt) noexcept {
     // The current model over [t_{k-1}, t_k], the current taken as its mean over the period.
-    const T rho_T = Rr_Ohm_ * inv_Lr_ * period_s_;
-    const T share = rho_T * (T(1) - rho_T * (T(0.5) - rho_T * (T(1) / T(6))));  // 1 - e^{-rho T}
-    flux_AB_Wb_ += share * (Lm_H_ * T(0.5) * (i_AB_A + i_AB_last_A_) - flux_AB_Wb_);
-    // Q^ over the period: i.Psi^ and i x Psi^ by the trapezoid, with the period's mean speed.
-    const T along_now = i_AB_A.dot(flux_AB_Wb_), across_now = cross(i_AB_A, flux_AB_Wb_);
-    const T q_adapt = Lm_over_Lr_ * T(0.5) *
-                      (p_ * omega_mean_rad_s * (along_now + along_last_) -
-                       Rr_Ohm_ * inv_Lr_ * (across_now + across_last_));
-    const Vec2<T> i_mean_A = T(0.5) * (i_alphabeta_A + i_alphabeta_last_A_);
-    const T q_ref =
-        cross(i_mean_A, u_alphabeta_V) - sigma_over_T_ * cross(i_alphabeta_last_A_, i_alphabeta_A);
-    q_ref_ += filter_ * (q_ref - q_ref_);
-    q_adapt_ += filter_ * (q_adapt - q_adapt_);
-    along_ += filter_ * (along_now - along_);
-    across_ += filter_ * (-across_now - across_);  // Psi^ x i
-    tangent_ = along_ > T(0) ? across_ / along_ : T(0);
-    const T omega_e = p_ * omega_mech_rad_s + tangent_ * Rr_Ohm_ * inv_Lr_;
-    // The filtered powers must also have been drawn above that frequency: in steady state
-    // q_adapt_ = (Lm/Lr) w_e i.Psi^, and after a reversal the filters still hold the powers of
-    // the slower frequencies of the last ~tau_r, near zero, whose ratio the voltage's errors
-    // decide (docs/robustness.md, "Near a reversal").
-    const T q_floor = min_frequency_ * Lm_over_Lr_ * along_;
-    adapting_ = adapt && along_ > T(0) && std::abs(tangent_) >= min_tangent_ &&
-                std::abs(omega_e) >= min_frequency_ && q_adapt_ * omega_e > T(0) &&
-                std::abs(q_adapt_) >= q_floor;
-    const T relative = adapting_ ? (q_ref_ - q_adapt_) / q_adapt_ : T(0);  // divides if used
-    if (adapting_ && std::isfinite(relative)) {
-      // The relative step, bounded: one tick moves the estimate by at most gain x 100 %. The
-      // steps (gain ~ 1e-4 and less) are summed apart and applied once they reach 1e-4: in
-      // float, Rr (1 + step) would round a step below 6e-8 away and stall the estimate.
-      pending_ += gain_ * std::clamp(relative, T(-1), T(1));
-      if (std::abs(pending_) >= T(1e-4)) {
-        Rr_Ohm_ = std::clamp(Rr_Ohm_ * (T(1) + pending_), Rr_min_Ohm_, Rr_max_Ohm_);
-        pending_ = T(0);
-      }
-    }
-    if (!all_finite(q_ref_, q_adapt_, along_, across_, flux_AB_Wb_.x(), flux_AB_Wb_.y())) {
-      reset_filters();  // a non-finite input must not stay in the filters
-    }
-    i_AB_last_A_ = i_AB_A;
-    i_alphabeta_last_A_ = i_alphabeta_A;
-    along_last_ = along_now;
-    across_last_ = across_now;
+    s_.flux_AB_Wb += share_ * (half_Lm_H_ * (i_AB_A + s_.i_AB_last_A) - s_.flux_AB_Wb);
+    // Q^ over the period: i.Psi^ and i x Psi^ by the trapezoid, with the period's mean speed;
+    // Q likewise from the mean current (both summed without their common factors, applied
+    // once per block).
+    const T along_now = i_AB_A.dot(s_.flux_AB_Wb), across_now = cross(i_AB_A, s_.flux_AB_Wb);
+    s_.sum_q_adapt +=
+        p_ * omega_mean_rad_s * (along_now + s_.along_last) - rho_ * (across_now + s_.across_last);
+    s_.sum_q_ref += cross(i_alphabeta_A + s_.i_alphabeta_last_A, u_alphabeta_V) -
+                    two_sigma_over_T_ * cross(s_.i_alphabeta_last_A, i_alphabeta_A);
+    s_.sum_along += along_now;
+    s_.sum_across += across_now;
+    s_.block_adapts = s_.block_adapts && adapt;
+    s_.i_AB_last_A = i_AB_A;
+    s_.i_alphabeta_last_A = i_alphabeta_A;
+    s_.along_last = along_now;
+    s_.across_last = across_now;
+    if (++s_.in_block >= rates_.block) end_block(omega_mech_rad_s);
   }
 
   /// Carries the estimate and the filters over from the tracker of the model this one replaces
   /// (the same motor but for Rr).
-  void continue_from(const RotorResistanceMras& old) noexcept {
+  [[gnu::noinline]] void continue_from(const RotorResistanceMras& old) noexcept {
     Rr_Ohm_ = std::clamp(old.Rr_Ohm_, Rr_min_Ohm_, Rr_max_Ohm_);
-    flux_AB_Wb_ = old.flux_AB_Wb_;
-    i_AB_last_A_ = old.i_AB_last_A_;
-    i_alphabeta_last_A_ = old.i_alphabeta_last_A_;
-    along_last_ = old.along_last_;
-    across_last_ = old.across_last_;
-    q_ref_ = old.q_ref_;
-    q_adapt_ = old.q_adapt_;
-    along_ = old.along_;
-    across_ = old.across_;
-    tangent_ = old.tangent_;
-    adapting_ = old.adapting_;
-    pending_ = old.pending_;
+    s_ = old.s_;  // a block longer than this one's ends at the next tick
+    set_current_model();
   }
 
  private:
-  void reset_filters() noexcept {
-    flux_AB_Wb_ = i_AB_last_A_ = i_alphabeta_last_A_ = Vec2<T>::Zero();
-    along_last_ = across_last_ = q_ref_ = q_adapt_ = along_ = across_ = tangent_ = pending_ = T(0);
+  /// The block's means through the filters, the tests of excitation and the adaptation.
+  [[gnu::always_inline]] void end_block(T omega_mech_rad_s) noexcept {
+    const T ticks = T(s_.in_block), per_tick = T(1) / ticks;       // the block's but after a swap
+    const T q_ref = T(0.5) * per_tick * s_.sum_q_ref;
+    const T q_adapt = Lm_over_Lr_ * T(0.5) * per_tick * s_.sum_q_adapt;
+    s_.q_ref += rates_.filter * (q_ref - s_.q_ref);
+    s_.q_adapt += rates_.filter * (q_adapt - s_.q_adapt);
+    s_.along += rates_.filter * (per_tick * s_.sum_along - s_.along);
+    s_.across += rates_.filter * (-per_tick * s_.sum_across - s_.across);  // Psi^ x i
+    s_.tangent = s_.along > T(0) ? s_.across / s_.along : T(0);
+    const T omega_e = p_ * omega_mech_rad_s + s_.tangent * rho_;
+    // The filtered powers must also have been drawn above that frequency: in steady state
+    // the filtered Q^ = (Lm/Lr) w_e i.Psi^, and after a reversal the filters still hold the
+    // powers of the slower frequencies of the last ~tau_r, near zero, whose ratio the voltage's
+    // errors decide (docs/robustness.md, "Near a reversal").
+    const T q_floor = min_frequency_ * Lm_over_Lr_ * s_.along;
+    s_.adapting = s_.block_adapts && s_.along > T(0) && std::abs(s_.tangent) >= min_tangent_ &&
+                  std::abs(omega_e) >= min_frequency_ && s_.q_adapt * omega_e > T(0) &&
+                  std::abs(s_.q_adapt) >= q_floor;
+    const T relative =
+        s_.adapting ? (s_.q_ref - s_.q_adapt) / s_.q_adapt : T(0);  // divides if used
+    if (s_.adapting && std::isfinite(relative)) {
+      // The relative step, bounded: one tick moves the estimate by at most gain x 100 %. The
+      // steps (gain ~ 1e-4 a tick and less) are summed apart and applied once they reach 1e-4:
+      // in float, Rr (1 + step) would round a step below 6e-8 away and stall the estimate.
+      s_.pending += ticks * rates_.gain * std::clamp(relative, T(-1), T(1));
+      if (std::abs(s_.pending) >= T(1e-4)) {
+        Rr_Ohm_ = std::clamp(Rr_Ohm_ * (T(1) + s_.pending), Rr_min_Ohm_, Rr_max_Ohm_);
+        s_.pending = T(0);
+        set_current_model();
+      }
+    }
+    if (!all_finite(s_.q_ref, s_.q_adapt, s_.along, s_.across, s_.flux_AB_Wb.x(),
+                    s_.flux_AB_Wb.y())) {
+      reset_filters();  // a non-finite input must not stay in the filters
+    }
+    s_.sum_q_ref = s_.sum_q_adapt = s_.sum_along = s_.sum_across = T(0);
+    s_.in_block = 0;
+    s_.block_adapts = true;
   }
+
+  /// The block's length, the filters' share per block (the per-tick share T / tau_f applied
+  /// block times over, 1 - (1 - T / tau_f)^block, by products: no exponential in the image)
+  /// and the adaptation's gain per tick, T / tau_c. Not inlined: built once per model.
+  [[gnu::noinline]] static Rates rates(const MotorParameters& m,
+                                       const RotorResistanceMrasConfig& c) noexcept {
+    const Real tau_f_s = filter_s(m, c), tau_c_s = convergence_s(m, c);
+    Rates r;
+    r.block = mras_block_ticks(std::min(tau_f_s, tau_c_s), c.sample_period_s);
+    Real kept = 1;
+    for (int k = 0; k < r.block; ++k) kept *= 1 - c.sample_period_s / tau_f_s;
+    r.filter = T(1 - kept);
+    r.gain = T(c.sample_period_s / tau_c_s);
+    return r;
+  }
+
+  /// The current model's constants on the estimate: rho^ = Rr^/Lr and the share 1 - e^{-rho^ T}.
+  [[gnu::noinline]] void set_current_model() noexcept {  // once per model and per Rr step
+    rho_ = Rr_Ohm_ * inv_Lr_;
+    const T rho_T = rho_ * period_s_;
+    share_ = rho_T * (T(1) - rho_T * (T(0.5) - rho_T * (T(1) / T(6))));  // 1 - e^{-rho T}
+  }
+
+  void reset_filters() noexcept { s_ = State{}; }
 
   /// a x b = a_x b_y - a_y b_x (the reactive power of a current and a voltage).
   static T cross(const Vec2<T>& a, const Vec2<T>& b) noexcept {
     return a.x() * b.y() - a.y() * b.x();
   }
 
-  T period_s_, Lm_H_, Lm_over_Lr_, inv_Lr_, sigma_over_T_, p_, filter_, gain_;
+  T period_s_, half_Lm_H_, Lm_over_Lr_, inv_Lr_, two_sigma_over_T_, p_;
+  Rates rates_;
   T min_tangent_, min_frequency_, Rr_min_Ohm_, Rr_max_Ohm_, inv_nominal_;
   T Rr_Ohm_;
-  Vec2<T> flux_AB_Wb_ = Vec2<T>::Zero();
-  Vec2<T> i_AB_last_A_ = Vec2<T>::Zero(), i_alphabeta_last_A_ = Vec2<T>::Zero();
-  T along_last_ = T(0), across_last_ = T(0);  ///< i.Psi^ and i x Psi^ at t_{k-1}
-  T q_ref_ = T(0), q_adapt_ = T(0), along_ = T(0), across_ = T(0);
-  T tangent_ = T(0);
-  T pending_ = T(0);  ///< relative steps not yet applied to Rr_Ohm_
-  bool adapting_ = false;
+  T rho_ = T(0), share_ = T(0);  ///< of the current model, on Rr_Ohm_ (set_current_model())
+  State s_;
 };
 
 }  // namespace imd::control

@@ -71,14 +71,11 @@ SvpwmResult<T> svpwm(Vec2<T> u_alphabeta_V, T v_bus_V) noexcept {
   // The duties span 0.5 -/+ (max - min) / (2 v_bus), and max - min <= sqrt(3) |u|: inside the
   // linear range by 1e-5 of its radius they lie inside [0, 1] by 5e-6, far beyond their
   // rounding (a few 2^-24). Only nearer the edge may rounding put one outside: clamped there.
-  if (magnitude2 <= T(1 - 2e-5) * (limit * limit)) {
-    for (int phase = 0; phase < 3; ++phase) {
-      result.duty[phase] = T(0.5) + (v[phase] + offset) * per_bus;
-    }
-    return result;
-  }
   for (int phase = 0; phase < 3; ++phase) {
-    result.duty[phase] = std::clamp(T(0.5) + (v[phase] + offset) * per_bus, T(0), T(1));
+    result.duty[phase] = T(0.5) + (v[phase] + offset) * per_bus;
+  }
+  if (!(magnitude2 <= T(1 - 2e-5) * (limit * limit))) {
+    for (T& duty : result.duty) duty = std::clamp(duty, T(0), T(1));
   }
   return result;
 }

@@ -92,7 +92,10 @@ class Supervisor {
   /// Latches the faults the protect stage found (the first one keeps its code and time) and
   /// starts their stop (firmware/protection/stop_category.hpp). True: STO, the caller turns the
   /// PWM off now; false: a controlled stop (SS1 or DC braking) runs, or continues, first.
-  bool latch(const Trip& trip, uint64_t k, const StopContext<T>& motion = {}) noexcept;
+  /// Cold, as every fault path and command handler here: built for size (a fault or a command
+  /// is a rare tick).
+  [[gnu::cold]] bool latch(const Trip& trip, uint64_t k,
+                           const StopContext<T>& motion = {}) noexcept;
   /// A fault's controlled stop is under way (the state is stopping, the fault latched).
   bool fault_stopping() const noexcept { return fault_stop_; }
   /// The program running the drive ends: to idle if modulating (the motor coasts).
@@ -141,24 +144,24 @@ class Supervisor {
   /// tick's path through plan() stays a short function.
   [[gnu::noinline]] const TickPlan<T>& replan(uint64_t k, const Measurement<T>& m,
                                               const Estimate<T>& e, bool restarted) noexcept;
-  protocol::CommandResult apply(const protocol::Command& command, uint64_t k,
-                                bool& restarted) noexcept;
-  void enable(uint64_t k, bool& restarted) noexcept;
-  protocol::CommandResult clear_faults(uint64_t k, bool& restarted) noexcept;
+  [[gnu::cold]] protocol::CommandResult apply(const protocol::Command& command, uint64_t k,
+                                              bool& restarted) noexcept;
+  [[gnu::cold]] void enable(uint64_t k, bool& restarted) noexcept;
+  [[gnu::cold]] protocol::CommandResult clear_faults(uint64_t k, bool& restarted) noexcept;
   /// A fault's controlled stop ended (at standstill, or at its time limit): STO.
-  void end_fault_stop(uint64_t k, TickPlan<T>& p) noexcept;
+  [[gnu::cold]] void end_fault_stop(uint64_t k, TickPlan<T>& p) noexcept;
   bool read_enable_input() const noexcept;
   void select(ControllerKind kind) noexcept;
   /// The state the drive rests in once calibrated: idle, or unconfigured without a model.
   DriveState rest_state() const noexcept {
     return laws_ != nullptr ? DriveState::idle : DriveState::unconfigured;
   }
-  protocol::CommandResult access_parameter(const protocol::Command& c, uint64_t k,
-                                           bool& restarted) noexcept;
+  [[gnu::cold]] protocol::CommandResult access_parameter(const protocol::Command& c, uint64_t k,
+                                                         bool& restarted) noexcept;
   /// The answers the service loop has ready; a write that completed a record starts the
   /// change of model (idle -> unconfigured).
-  void answer_served_access(uint64_t k) noexcept;
-  void answer_parameter(const ParameterAnswer& a) noexcept;
+  [[gnu::cold]] void answer_served_access(uint64_t k) noexcept;
+  [[gnu::cold]] void answer_parameter(const ParameterAnswer& a) noexcept;
   bool commands_over_can_, auto_enable_;
   int enable_input_line_;
   SupervisorWiring wiring_;

@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <numbers>
+#include <optional>
 
 #include "control/rotor_resistance_mras.hpp"
 #include "hal_sim/induction_motor_plant.hpp"
@@ -150,6 +151,40 @@ TEST(RotorResistanceMras, FloatFollowsDouble) {
   }
   // float's 2^-24 on each product, accumulated through the filters: 1e-4 relative.
   EXPECT_NEAR(single.Rr_Ohm() / twice.Rr_Ohm(), 1.0, 1e-4);
+}
+
+// The filters and the adaptation run once a block (mras_block_ticks(): tau/32, at most 64
+// ticks). A tracker that takes over from another in the middle of a block (a retuned model on
+// the same motor) must carry on exactly where it left off: its sums, its count and its filters.
+TEST(RotorResistanceMras, TakingOverInTheMiddleOfABlockChangesNothing) {
+  const test::TestMotor tm = test::test_motors()[0];
+  const MotorParameters& m = tm.parameters;
+  RotorResistanceMrasConfig config;
+  MotorParameters model = m;
+  model.Rr_Ohm = 1.5 * m.Rr_Ohm;
+  RotorResistanceMras<double> alone(model, config, m.Rr_Ohm);
+  const int block = alone.block_ticks();
+  // The model's tau_r (its Rr 1.5 times the motor's: 27 ms) over 32 periods of 100 us.
+  EXPECT_EQ(block, mras_block_ticks(m.Lr_H / (1.5 * m.Rr_Ohm), config.sample_period_s));
+  EXPECT_EQ(block, 8);
+  std::optional<RotorResistanceMras<double>> swapped(std::in_place, model, config, m.Rr_Ohm);
+  const double i_d = tm.flux_Wb / m.Lm_H, omega = 100.0, slip = m.Rr_Ohm / m.Lr_H;
+  for (int k = 0; k < 20000; ++k) {
+    if (k % 997 == 0 && k > 0) {  // 997 ticks: never at a block's end
+      RotorResistanceMras<double> next(model, config, m.Rr_Ohm);
+      next.continue_from(*swapped);
+      swapped.emplace(next);
+    }
+    const double t = k * 1e-4, angle = slip * t, theta = omega * t * m.pole_pairs;
+    const V2 i_AB = Rotation<double>::from_angle(angle).apply(V2(i_d, i_d));
+    const V2 i_ab = Rotation<double>::from_angle(theta).apply(i_AB);
+    const V2 u = Rotation<double>::from_angle(theta + angle).apply(V2(10.0, 300.0));
+    alone.step(i_ab, i_AB, omega, omega, u, true);
+    swapped->step(i_ab, i_AB, omega, omega, u, true);
+    ASSERT_EQ(alone.Rr_Ohm(), swapped->Rr_Ohm()) << k;
+    ASSERT_EQ(alone.q_reference_var(), swapped->q_reference_var()) << k;
+  }
+  EXPECT_NE(alone.Rr_Ohm(), model.Rr_Ohm);  // it adapted
 }
 
 }  // namespace
