@@ -129,25 +129,43 @@ TEST(RotorResistanceMras, ConvergesInFloatOnTheSlowestRotor) {
   }
 }
 
-TEST(RotorResistanceMras, FloatFollowsDouble) {
-  // The same run in float (the MCU's arithmetic) on the paper-000 motor.
-  const test::TestMotor tm = test::test_motors()[0];
-  const MotorParameters& m = tm.parameters;
+/// A synthetic steady state on the paper-000 motor in the rotor frame (current and flux turning
+/// at the slip, the rotor at 100 rad/s), for a tracker whose model starts at 1.5 x Rr.
+struct SyntheticSteadyState {
+  test::TestMotor tm = test::test_motors()[0];
   RotorResistanceMrasConfig config;
-  MotorParameters model = m;
-  model.Rr_Ohm = 1.5 * m.Rr_Ohm;
-  RotorResistanceMras<float> single(model, config, m.Rr_Ohm);
-  RotorResistanceMras<double> twice(model, config, m.Rr_Ohm);
-  // A synthetic steady state in the rotor frame: current and flux turning at the slip.
-  const double i_d = tm.flux_Wb / m.Lm_H, omega = 100.0, slip = m.Rr_Ohm / m.Lr_H;
-  for (int k = 0; k < 20000; ++k) {
+  MotorParameters model = with_Rr(tm.parameters, 1.5 * tm.parameters.Rr_Ohm);
+  double omega = 100.0;
+
+  static MotorParameters with_Rr(MotorParameters m, double Rr_Ohm) {
+    m.Rr_Ohm = Rr_Ohm;
+    return m;
+  }
+  template <typename Real>
+  RotorResistanceMras<Real> tracker() const {
+    return RotorResistanceMras<Real>(model, config, tm.parameters.Rr_Ohm);
+  }
+  /// Tick k's input to `mras`.
+  template <typename Real>
+  void step(RotorResistanceMras<Real>& mras, int k) const {
+    const MotorParameters& m = tm.parameters;
+    const double i_d = tm.flux_Wb / m.Lm_H, slip = m.Rr_Ohm / m.Lr_H;
     const double t = k * 1e-4, angle = slip * t, theta = omega * t * m.pole_pairs;
     const V2 i_AB = Rotation<double>::from_angle(angle).apply(V2(i_d, i_d));
     const V2 i_ab = Rotation<double>::from_angle(theta).apply(i_AB);
     const V2 u = Rotation<double>::from_angle(theta + angle).apply(V2(10.0, 300.0));
-    single.step(i_ab.cast<float>(), i_AB.cast<float>(), float(omega), float(omega), u.cast<float>(),
-                true);
-    twice.step(i_ab, i_AB, omega, omega, u, true);
+    mras.step(i_ab.cast<Real>(), i_AB.cast<Real>(), Real(omega), Real(omega), u.cast<Real>(), true);
+  }
+};
+
+TEST(RotorResistanceMras, FloatFollowsDouble) {
+  // The same run in float (the MCU's arithmetic) on the paper-000 motor.
+  const SyntheticSteadyState run;
+  RotorResistanceMras<float> single = run.tracker<float>();
+  RotorResistanceMras<double> twice = run.tracker<double>();
+  for (int k = 0; k < 20000; ++k) {
+    run.step(single, k);
+    run.step(twice, k);
   }
   // float's 2^-24 on each product, accumulated through the filters: 1e-4 relative.
   EXPECT_NEAR(single.Rr_Ohm() / twice.Rr_Ohm(), 1.0, 1e-4);
@@ -157,34 +175,25 @@ TEST(RotorResistanceMras, FloatFollowsDouble) {
 // ticks). A tracker that takes over from another in the middle of a block (a retuned model on
 // the same motor) must carry on exactly where it left off: its sums, its count and its filters.
 TEST(RotorResistanceMras, TakingOverInTheMiddleOfABlockChangesNothing) {
-  const test::TestMotor tm = test::test_motors()[0];
-  const MotorParameters& m = tm.parameters;
-  RotorResistanceMrasConfig config;
-  MotorParameters model = m;
-  model.Rr_Ohm = 1.5 * m.Rr_Ohm;
-  RotorResistanceMras<double> alone(model, config, m.Rr_Ohm);
+  const SyntheticSteadyState run;
+  RotorResistanceMras<double> alone = run.tracker<double>();
   const int block = alone.block_ticks();
   // The model's tau_r (its Rr 1.5 times the motor's: 27 ms) over 32 periods of 100 us.
-  EXPECT_EQ(block, mras_block_ticks(m.Lr_H / (1.5 * m.Rr_Ohm), config.sample_period_s));
+  EXPECT_EQ(block, mras_block_ticks(run.model.Lr_H / run.model.Rr_Ohm, run.config.sample_period_s));
   EXPECT_EQ(block, 8);
-  std::optional<RotorResistanceMras<double>> swapped(std::in_place, model, config, m.Rr_Ohm);
-  const double i_d = tm.flux_Wb / m.Lm_H, omega = 100.0, slip = m.Rr_Ohm / m.Lr_H;
+  std::optional<RotorResistanceMras<double>> swapped(run.tracker<double>());
   for (int k = 0; k < 20000; ++k) {
-    if (k % 997 == 0 && k > 0) {  // 997 ticks: never at a block's end
-      RotorResistanceMras<double> next(model, config, m.Rr_Ohm);
+    if (k % 997 == 0 && k > 0) {  // 997, prime: the swaps fall at every place within a block
+      RotorResistanceMras<double> next = run.tracker<double>();
       next.continue_from(*swapped);
       swapped.emplace(next);
     }
-    const double t = k * 1e-4, angle = slip * t, theta = omega * t * m.pole_pairs;
-    const V2 i_AB = Rotation<double>::from_angle(angle).apply(V2(i_d, i_d));
-    const V2 i_ab = Rotation<double>::from_angle(theta).apply(i_AB);
-    const V2 u = Rotation<double>::from_angle(theta + angle).apply(V2(10.0, 300.0));
-    alone.step(i_ab, i_AB, omega, omega, u, true);
-    swapped->step(i_ab, i_AB, omega, omega, u, true);
+    run.step(alone, k);
+    run.step(*swapped, k);
     ASSERT_EQ(alone.Rr_Ohm(), swapped->Rr_Ohm()) << k;
     ASSERT_EQ(alone.q_reference_var(), swapped->q_reference_var()) << k;
   }
-  EXPECT_NE(alone.Rr_Ohm(), model.Rr_Ohm);  // it adapted
+  EXPECT_NE(alone.Rr_Ohm(), run.model.Rr_Ohm);  // it adapted
 }
 
 }  // namespace
