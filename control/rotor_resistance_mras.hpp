@@ -41,8 +41,9 @@ struct RotorResistanceMrasConfig {
 /// Ticks summed before the filters, the tests and the adaptation run once on their means: a
 /// thirty-second of the shorter of the filter's and the adaptation's time constants. The mean
 /// delays the powers by half a block, tau / 64, which costs the adaptation's loop (crossover
-/// 1 / (4 tau_r)) a quarter of a degree of phase and shifts the filters' weights within a
-/// block by a few thousandths; at most 64 ticks, whose float sums keep 2^-18 of their terms.
+/// 1 / (4 tau_r)) a quarter of a degree of phase; within a block, where a filter run every tick
+/// would weigh the ticks by (1 - T/tau)^j, the mean weighs them alike (1.5 % apart at most, as
+/// N T / tau <= 1/32). At most 64 ticks, whose float sums keep 2^-18 of their terms.
 inline int mras_block_ticks(Real time_constant_s, Real sample_period_s) noexcept {
   const Real ticks = time_constant_s / (32 * sample_period_s);
   return ticks >= 64 ? 64 : (ticks >= 1 ? static_cast<int>(ticks) : 1);
@@ -161,7 +162,7 @@ class RotorResistanceMras {
  private:
   /// The block's means through the filters, the tests of excitation and the adaptation.
   [[gnu::always_inline]] void end_block(T omega_mech_rad_s) noexcept {
-    const T ticks = T(s_.in_block), per_tick = T(1) / ticks;       // the block's but after a swap
+    const T ticks = T(s_.in_block), per_tick = T(1) / ticks;  // block_ticks(), or after a swap more
     const T q_ref = T(0.5) * per_tick * s_.sum_q_ref;
     const T q_adapt = Lm_over_Lr_ * T(0.5) * per_tick * s_.sum_q_adapt;
     s_.q_ref += rates_.filter * (q_ref - s_.q_ref);
