@@ -162,7 +162,7 @@ class RotorResistanceMras {
  private:
   /// The block's means through the filters, the tests of excitation and the adaptation.
   [[gnu::always_inline]] void end_block(T omega_mech_rad_s) noexcept {
-    const T ticks = T(s_.in_block), per_tick = T(1) / ticks;  // block_ticks(), or after a swap more
+    const T ticks = T(s_.in_block), per_tick = T(1) / ticks;  // more than block_ticks() after a swap
     const T q_ref = T(0.5) * per_tick * s_.sum_q_ref;
     const T q_adapt = Lm_over_Lr_ * T(0.5) * per_tick * s_.sum_q_adapt;
     s_.q_ref += rates_.filter * (q_ref - s_.q_ref);
