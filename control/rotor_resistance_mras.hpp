@@ -162,7 +162,8 @@ class RotorResistanceMras {
  private:
   /// The block's means through the filters, the tests of excitation and the adaptation.
   [[gnu::always_inline]] void end_block(T omega_mech_rad_s) noexcept {
-    const T ticks = T(s_.in_block), per_tick = T(1) / ticks;  // more than block_ticks() after a swap
+    // The block's ticks: block_ticks(), or more once after a swap to a shorter block.
+    const T ticks = T(s_.in_block), per_tick = T(1) / ticks;
     const T q_ref = T(0.5) * per_tick * s_.sum_q_ref;
     const T q_adapt = Lm_over_Lr_ * T(0.5) * per_tick * s_.sum_q_adapt;
     s_.q_ref += rates_.filter * (q_ref - s_.q_ref);
