@@ -176,10 +176,11 @@ SupervisedState Supervisor<T>::supervised(uint64_t k, const TickPlan<T>& p) cons
   s.enable_input = enable_input_;
   s.magnetizing = machine_.state() == DriveState::magnetizing;
   s.dc_braking = p.mode == Mode::dc_braking;
-  s.magnetizing_ticks = saturated_ticks(k - magnetizing_start_tick_);
+  // The counts only where they are judged: a 64-bit difference and its saturation each.
+  if (s.magnetizing) s.magnetizing_ticks = saturated_ticks(k - magnetizing_start_tick_);
   s.watchdog_armed = commands_over_can_ && (machine_.state() == DriveState::magnetizing ||
                                             machine_.state() == DriveState::running);
-  s.command_silence_ticks = saturated_ticks(k - last_command_tick_);
+  if (s.watchdog_armed) s.command_silence_ticks = saturated_ticks(k - last_command_tick_);
   return s;
 }
 

@@ -87,6 +87,8 @@ void Telemetry::publish(uint64_t k, hal::CanBus& can, const TickRecord<T>& r,
                         const DriveStatus& status, const StateMachine& machine,
                         const ExecutionStats& execution, uint32_t budget_ns) noexcept {
   send_state_changes(can, machine);  // events go at once
+  // The common tick: no cyclic frame due, none waiting (one 64-bit comparison for three).
+  if (k < next_due_k_ && pending_ == 0) return;
   if (k >= next_heartbeat_k_) {
     next_heartbeat_k_ = next_due(next_heartbeat_k_, k, ticks_per_10Hz_);
     pending_ |= kHeartbeatDue;
@@ -117,6 +119,7 @@ void Telemetry::publish(uint64_t k, hal::CanBus& can, const TickRecord<T>& r,
                             float(sample_count_++), float(r.rr_scale)}));
     sample = true;
   }
+  next_due_k_ = std::min({next_heartbeat_k_, next_timing_k_, next_fast_k_});
   // A frame costs the tick hundreds of instructions: with enough ticks between the 10 Hz
   // frames, the other cyclic frames go one a tick, on ticks without a sample (unless a sample
   // takes every tick), the first due in this order; each carries its tick's values. A slower

@@ -114,6 +114,7 @@ class Telemetry {
   // half a heartbeat period later, fast telemetry at 1: the first ticks send the version and
   // the heartbeat, then the first sample); a new rate applies from the next.
   uint64_t next_heartbeat_k_ = 0, next_timing_k_, next_fast_k_ = 1;
+  uint64_t next_due_k_ = 0;  ///< the earliest of the three
   int rate_Hz_ = 100;
   uint8_t heartbeat_count_ = 0;
   uint8_t sample_count_ = 0;

@@ -46,8 +46,8 @@ struct SupervisedState {
   /// time ago): the load is unbounded, so the encoder check judges only jumps.
   bool brake_may_hold = false;
   bool watchdog_armed = false;         ///< CAN-commanded and magnetizing or running
-  uint32_t magnetizing_ticks = 0;      ///< since magnetizing began (saturates)
-  uint32_t command_silence_ticks = 0;  ///< since the last valid command (saturates)
+  uint32_t magnetizing_ticks = 0;      ///< since magnetizing began (saturates; 0 if not)
+  uint32_t command_silence_ticks = 0;  ///< since the last valid command (saturates; 0 unarmed)
 };
 
 /// The checks built from the motor parameters: they are part of the motor model, rebuilt with
