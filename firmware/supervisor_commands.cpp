@@ -221,10 +221,10 @@ void Supervisor<T>::answer_parameter(const ParameterAnswer& a) noexcept {
 // The class is instantiated in supervisor.cpp; these members are defined here.
 #define IMD_INSTANTIATE_COMMANDS(T)                                                         \
   template void Supervisor<T>::receive_commands(uint64_t, bool&) noexcept;                  \
-  template void Supervisor<T>::enable(uint64_t, bool&) noexcept;                     \
-  template protocol::CommandResult Supervisor<T>::clear_faults(uint64_t, bool&) noexcept; \
+  template void Supervisor<T>::enable(uint64_t, bool&) noexcept;                            \
+  template protocol::CommandResult Supervisor<T>::clear_faults(uint64_t, bool&) noexcept;   \
   template protocol::CommandResult Supervisor<T>::apply(const protocol::Command&, uint64_t, \
-                                                        bool&) noexcept;                   \
+                                                        bool&) noexcept;                    \
   template protocol::CommandResult Supervisor<T>::access_parameter(                         \
       const protocol::Command&, uint64_t, bool&) noexcept;                                  \
   template void Supervisor<T>::answer_served_access(uint64_t) noexcept;                     \
