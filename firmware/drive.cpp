@@ -90,7 +90,6 @@ void Drive<T>::on_tick() noexcept {
   after_write(m, e, plan.mode == Mode::controlling && model != nullptr, u_acted_V, model);
   publish(k, m, e, plan, u, out, model);
   supervisor_.prepare(k);  // the next tick's plan, off the path to its write
-  // A commissioning's end, looked at only while one runs or hands over (most ticks: neither).
   if (adopt_pending_ || supervisor_.state() == DriveState::identifying) end_identification(k);
   if (bank_.apply_wanted()) release_model();
   clock.lap(Stage::publish);

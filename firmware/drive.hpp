@@ -145,7 +145,8 @@ class Drive final : public hal::TickHandler {
   /// A fault's DC braking: its stator voltage from the measured current, straight to SVPWM.
   Modulation<T> dc_brake(const Measurement<T>& m, const Estimate<T>& e,
                          MotorModel<T>& model) noexcept;
-  /// After the tick: a finished commissioning hands its result to the service loop.
+  /// After the tick: a finished commissioning hands its result to the service loop. The tick
+  /// calls it only while one runs or hands over (adopt_pending_): most ticks, neither.
   void end_identification(uint64_t k) noexcept;
   // The service loop's side of the commissioning.
   void plan_commissioning() noexcept;
